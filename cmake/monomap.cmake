@@ -1,0 +1,23 @@
+# monomap_library(NAME <module> SRCS ... DEPS ...)
+# One static library per module folder: monomap_<module>. Includes are
+# rooted at src/ so code writes #include "monomap/geometry/rigid3.h".
+function(monomap_library)
+  cmake_parse_arguments(ARG "" "NAME" "SRCS;DEPS" ${ARGN})
+  set(target monomap_${ARG_NAME})
+  add_library(${target} STATIC ${ARG_SRCS})
+  target_include_directories(${target} PUBLIC ${PROJECT_SOURCE_DIR}/src)
+  target_link_libraries(${target} PUBLIC ${ARG_DEPS})
+endfunction()
+
+# monomap_test(NAME <name> SRCS ... DEPS ...)
+# A GoogleTest executable registered with CTest (tests discovered per case).
+function(monomap_test)
+  cmake_parse_arguments(ARG "" "NAME" "SRCS;DEPS" ${ARGN})
+  if(NOT MONOMAP_BUILD_TESTS)
+    return()
+  endif()
+  add_executable(${ARG_NAME} ${ARG_SRCS})
+  target_link_libraries(${ARG_NAME} PRIVATE ${ARG_DEPS} GTest::gtest GTest::gtest_main)
+  gtest_discover_tests(${ARG_NAME} DISCOVERY_TIMEOUT 60
+                       PROPERTIES ENVIRONMENT "MONOMAP_SOURCE_DIR=${PROJECT_SOURCE_DIR}")
+endfunction()

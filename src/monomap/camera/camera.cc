@@ -1,0 +1,89 @@
+#include "monomap/camera/camera.h"
+
+#include <cmath>
+
+#include "monomap/util/error.h"
+
+namespace monomap {
+
+bool Camera::HasDistortion() const {
+  for (double d : distortion) {
+    if (d != 0.0) return true;
+  }
+  return false;
+}
+
+Eigen::Matrix3d Camera::K() const {
+  Eigen::Matrix3d k;
+  k << fx, 0, cx, 0, fy, cy, 0, 0, 1;
+  return k;
+}
+
+Eigen::Vector2d Camera::Distort(const Eigen::Vector2d& xn) const {
+  const double k1 = distortion[0], k2 = distortion[1], p1 = distortion[2],
+               p2 = distortion[3], k3 = distortion[4];
+  const double x = xn.x(), y = xn.y();
+  const double r2 = x * x + y * y;
+  const double radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3));
+  return {x * radial + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x),
+          y * radial + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y};
+}
+
+Eigen::Vector2d Camera::Undistort(const Eigen::Vector2d& xd) const {
+  if (!HasDistortion()) return xd;
+  Eigen::Vector2d x = xd;
+  for (int iter = 0; iter < 20; ++iter) {
+    const Eigen::Vector2d r = Distort(x) - xd;
+    if (r.squaredNorm() < 1e-24) break;
+    // Numeric Jacobian: cheap and exact enough for a 2x2 Newton step.
+    constexpr double kEps = 1e-7;
+    Eigen::Matrix2d j;
+    j.col(0) = (Distort(x + Eigen::Vector2d(kEps, 0)) - Distort(x)) / kEps;
+    j.col(1) = (Distort(x + Eigen::Vector2d(0, kEps)) - Distort(x)) / kEps;
+    x -= j.inverse() * r;
+  }
+  return x;
+}
+
+Eigen::Vector2d Camera::ImageFromCam(const Eigen::Vector3d& x_in_cam) const {
+  const Eigen::Vector2d xd = Distort(x_in_cam.hnormalized());
+  return {fx * xd.x() + cx, fy * xd.y() + cy};
+}
+
+Eigen::Vector2d Camera::NormalizedFromImage(const Eigen::Vector2d& px) const {
+  return Undistort({(px.x() - cx) / fx, (px.y() - cy) / fy});
+}
+
+Camera Camera::Scaled(int new_width, int new_height) const {
+  Camera c = *this;
+  const double sx = static_cast<double>(new_width) / width;
+  const double sy = static_cast<double>(new_height) / height;
+  c.width = new_width;
+  c.height = new_height;
+  c.fx = fx * sx;
+  c.fy = fy * sy;
+  c.cx = (cx + 0.5) * sx - 0.5;
+  c.cy = (cy + 0.5) * sy - 0.5;
+  return c;
+}
+
+Camera Camera::Pinhole() const {
+  Camera c = *this;
+  c.distortion = {0, 0, 0, 0, 0};
+  return c;
+}
+
+void Camera::Check() const {
+  CheckOption(width > 0 && height > 0, "camera.image_width/image_height",
+              "must be positive");
+  CheckOption(std::isfinite(fx) && fx > 0 && std::isfinite(fy) && fy > 0,
+              "camera.camera_matrix", "focal lengths must be positive");
+  CheckOption(std::isfinite(cx) && std::isfinite(cy), "camera.camera_matrix",
+              "principal point must be finite");
+  for (double d : distortion) {
+    CheckOption(std::isfinite(d), "camera.distortion_coefficients",
+                "must be finite");
+  }
+}
+
+}  // namespace monomap

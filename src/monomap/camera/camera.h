@@ -1,0 +1,55 @@
+// Pinhole camera with plumb_bob (Brown-Conrady) distortion, the model of ROS
+// camera_info and OpenCV: k1, k2, k3 radial, p1, p2 tangential, applied to
+// normalized coordinates.
+#pragma once
+
+#include <array>
+#include <string>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+namespace monomap {
+
+struct Camera {
+  int width = 0;
+  int height = 0;
+  double fx = 0, fy = 0, cx = 0, cy = 0;
+  // k1, k2, p1, p2, k3 (OpenCV order).
+  std::array<double, 5> distortion = {0, 0, 0, 0, 0};
+
+  bool HasDistortion() const;
+  Eigen::Matrix3d K() const;
+
+  // Normalized undistorted (x/z, y/z) -> normalized distorted.
+  Eigen::Vector2d Distort(const Eigen::Vector2d& xn) const;
+  // Inverse of Distort by Gauss-Newton (converges for real lenses within
+  // the image).
+  Eigen::Vector2d Undistort(const Eigen::Vector2d& xd) const;
+
+  // Camera-frame point -> raw (distorted) pixel. Caller checks z > 0.
+  Eigen::Vector2d ImageFromCam(const Eigen::Vector3d& x_in_cam) const;
+  // Raw pixel -> undistorted normalized coordinates (ray (x, y, 1)).
+  Eigen::Vector2d NormalizedFromImage(const Eigen::Vector2d& px) const;
+  // Undistorted normalized -> pixel of the ideal pinhole (no distortion).
+  Eigen::Vector2d PinholeFromNormalized(const Eigen::Vector2d& xn) const {
+    return {fx * xn.x() + cx, fy * xn.y() + cy};
+  }
+
+  bool InImage(const Eigen::Vector2d& px, double margin = 0.0) const {
+    return px.x() >= -0.5 + margin && px.y() >= -0.5 + margin &&
+           px.x() <= width - 0.5 - margin && px.y() <= height - 0.5 - margin;
+  }
+
+  // The same camera for images resized to new_width x new_height (pixel
+  // centres convention: u' + 0.5 = s (u + 0.5)). Distortion is unchanged.
+  Camera Scaled(int new_width, int new_height) const;
+  // The same intrinsics without distortion (for rendering and undistorted
+  // images).
+  Camera Pinhole() const;
+
+  // Throws OptionsError naming the field if a value makes no sense.
+  void Check() const;
+};
+
+}  // namespace monomap

@@ -1,0 +1,345 @@
+#include "monomap/io/dataset.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <cmath>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <sstream>
+
+#include "monomap/io/trajectory_io.h"
+#include "monomap/util/error.h"
+#include "monomap/util/file.h"
+
+namespace monomap {
+namespace fs = std::filesystem;
+
+void DatasetOptions::Check() const {
+  CheckOption(max_odometry_gap > 0, "dataset.max_odometry_gap", "must be > 0");
+  CheckOption(first_frame >= 0, "dataset.first_frame", "must be >= 0");
+  CheckOption(num_frames == -1 || num_frames > 0, "dataset.num_frames",
+              "must be -1 (all) or > 0");
+}
+
+namespace {
+
+YAML::Node LoadYaml(const fs::path& path) {
+  const std::string text = ReadFileToString(path);
+  try {
+    return YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    throw InputError(path.string(), e.mark.line + 1,
+                     "malformed YAML: " + e.msg);
+  }
+}
+
+std::vector<double> ReadNumbers(const fs::path& path, const YAML::Node& node,
+                                const std::string& field, size_t count) {
+  if (!node || !node.IsSequence()) {
+    throw InputError(path.string(), field, "missing or not a list");
+  }
+  if (node.size() != count) {
+    throw InputError(path.string(), field,
+                     "expected " + std::to_string(count) + " numbers, got " +
+                         std::to_string(node.size()));
+  }
+  std::vector<double> values;
+  for (const auto& v : node) {
+    double d = 0;
+    try {
+      d = v.as<double>();
+    } catch (const YAML::Exception&) {
+      throw InputError(path.string(), field, "value is not a number");
+    }
+    if (!std::isfinite(d)) {
+      throw InputError(path.string(), field, "value is not finite");
+    }
+    values.push_back(d);
+  }
+  return values;
+}
+
+int ReadInt(const fs::path& path, const YAML::Node& root,
+            const std::string& field) {
+  const YAML::Node n = root[field];
+  if (!n) throw InputError(path.string(), field, "missing");
+  try {
+    return n.as<int>();
+  } catch (const YAML::Exception&) {
+    throw InputError(path.string(), field, "not an integer");
+  }
+}
+
+struct RgbEntry {
+  double timestamp;
+  fs::path path;
+  int line;
+};
+
+std::vector<RgbEntry> ReadRgbList(const fs::path& root) {
+  const fs::path list = root / "rgb.txt";
+  std::vector<RgbEntry> entries;
+  for (const TextLine& line : ReadDataLines(list)) {
+    const auto tokens = SplitWhitespace(line.text);
+    if (tokens.size() != 2) {
+      throw InputError(list.string(), line.number,
+                       "expected 'timestamp path', got " +
+                           std::to_string(tokens.size()) + " fields");
+    }
+    RgbEntry e;
+    if (!ParseDouble(tokens[0], &e.timestamp)) {
+      throw InputError(list.string(), line.number,
+                       "timestamp '" + tokens[0] + "' is not a number");
+    }
+    if (!entries.empty() && e.timestamp <= entries.back().timestamp) {
+      throw InputError(list.string(), line.number,
+                       "timestamp " + tokens[0] + " does not increase");
+    }
+    e.path = root / tokens[1];
+    if (!fs::is_regular_file(e.path)) {
+      throw InputError(list.string(), line.number,
+                       "image '" + tokens[1] + "' not found");
+    }
+    e.line = line.number;
+    entries.push_back(e);
+  }
+  if (entries.empty()) throw InputError(list.string() + ": no frames listed");
+  return entries;
+}
+
+std::vector<std::pair<double, Pose2d>> ReadOdometry2d(const fs::path& path) {
+  std::vector<std::pair<double, Pose2d>> out;
+  for (const TextLine& line : ReadDataLines(path)) {
+    const auto tokens = SplitWhitespace(line.text);
+    if (tokens.size() != 4) {
+      throw InputError(path.string(), line.number,
+                       "expected 'timestamp x y yaw', got " +
+                           std::to_string(tokens.size()) + " fields");
+    }
+    double v[4];
+    for (int i = 0; i < 4; ++i) {
+      if (!ParseDouble(tokens[i], &v[i])) {
+        throw InputError(path.string(), line.number,
+                         "value '" + tokens[i] + "' is not a finite number");
+      }
+    }
+    if (!out.empty() && v[0] <= out.back().first) {
+      throw InputError(path.string(), line.number,
+                       "timestamp " + tokens[0] + " does not increase");
+    }
+    out.push_back({v[0], Pose2d{v[1], v[2], v[3]}});
+  }
+  if (out.empty()) throw InputError(path.string() + ": no poses");
+  return out;
+}
+
+}  // namespace
+
+Camera ReadCameraYaml(const fs::path& path) {
+  const YAML::Node root = LoadYaml(path);
+  if (!root.IsMap()) throw InputError(path.string() + ": not a YAML mapping");
+  Camera c;
+  c.width = ReadInt(path, root, "image_width");
+  c.height = ReadInt(path, root, "image_height");
+  if (c.width <= 0 || c.height <= 0) {
+    throw InputError(path.string(), "image_width/image_height",
+                     "must be positive");
+  }
+  const YAML::Node k = root["camera_matrix"];
+  if (!k) throw InputError(path.string(), "camera_matrix", "missing");
+  const auto kv = ReadNumbers(path, k["data"], "camera_matrix.data", 9);
+  c.fx = kv[0];
+  c.cx = kv[2];
+  c.fy = kv[4];
+  c.cy = kv[5];
+  if (c.fx <= 0 || c.fy <= 0) {
+    throw InputError(path.string(), "camera_matrix.data",
+                     "focal lengths must be positive");
+  }
+  if (kv[1] != 0.0 || kv[3] != 0.0 || kv[6] != 0.0 || kv[7] != 0.0 ||
+      kv[8] != 1.0) {
+    throw InputError(path.string(), "camera_matrix.data",
+                     "expected [fx 0 cx 0 fy cy 0 0 1] (no skew)");
+  }
+  if (const YAML::Node model = root["distortion_model"]) {
+    const std::string m = model.as<std::string>("");
+    if (m != "plumb_bob" && m != "none" && !m.empty()) {
+      throw InputError(path.string(), "distortion_model",
+                       "'" + m + "' is not supported (use plumb_bob)");
+    }
+  }
+  if (const YAML::Node d = root["distortion_coefficients"]) {
+    const YAML::Node data = d["data"];
+    if (!data || !data.IsSequence() || data.size() < 4 || data.size() > 5) {
+      throw InputError(path.string(), "distortion_coefficients.data",
+                       "expected 4 or 5 numbers (k1 k2 p1 p2 [k3])");
+    }
+    const auto dv = ReadNumbers(path, data, "distortion_coefficients.data",
+                                data.size());
+    for (size_t i = 0; i < dv.size(); ++i) c.distortion[i] = dv[i];
+  }
+  return c;
+}
+
+void WriteCameraYaml(const fs::path& path, const Camera& c,
+                     const std::string& name) {
+  std::ostringstream out;
+  out.precision(10);
+  out << "image_width: " << c.width << "\nimage_height: " << c.height
+      << "\ncamera_name: " << name << "\ncamera_matrix:\n  rows: 3\n"
+      << "  cols: 3\n  data: [" << c.fx << ", 0.0, " << c.cx << ", 0.0, "
+      << c.fy << ", " << c.cy << ", 0.0, 0.0, 1.0]\n"
+      << "distortion_model: plumb_bob\ndistortion_coefficients:\n  rows: 1\n"
+      << "  cols: 5\n  data: [" << c.distortion[0] << ", " << c.distortion[1]
+      << ", " << c.distortion[2] << ", " << c.distortion[3] << ", "
+      << c.distortion[4] << "]\n";
+  WriteFileAtomic(path, out.str());
+}
+
+Rigid3d ReadCameraMountYaml(const fs::path& path) {
+  const YAML::Node root = LoadYaml(path);
+  const YAML::Node m = root["base_from_cam"];
+  if (!m) throw InputError(path.string(), "base_from_cam", "missing");
+  const auto t = ReadNumbers(path, m["translation"],
+                             "base_from_cam.translation", 3);
+  const auto q = ReadNumbers(path, m["rotation_xyzw"],
+                             "base_from_cam.rotation_xyzw", 4);
+  const Eigen::Quaterniond quat(q[3], q[0], q[1], q[2]);
+  if (std::abs(quat.norm() - 1.0) > 1e-2) {
+    throw InputError(path.string(), "base_from_cam.rotation_xyzw",
+                     "quaternion is not unit length");
+  }
+  return Rigid3d(quat.normalized(), Eigen::Vector3d(t[0], t[1], t[2]));
+}
+
+void WriteCameraMountYaml(const fs::path& path, const Rigid3d& base_from_cam) {
+  std::ostringstream out;
+  out.precision(12);
+  const auto& t = base_from_cam.translation;
+  const auto& q = base_from_cam.rotation;
+  out << "# base_from_cam: camera pose in the robot base frame (x forward, "
+         "y left, z up, origin on the floor)\n"
+      << "base_from_cam:\n  translation: [" << t.x() << ", " << t.y() << ", "
+      << t.z() << "]\n  rotation_xyzw: [" << q.x() << ", " << q.y() << ", "
+      << q.z() << ", " << q.w() << "]\n";
+  WriteFileAtomic(path, out.str());
+}
+
+Rigid3d WorldFromCamOfBase(const Pose2d& base, const Rigid3d& base_from_cam) {
+  const Rigid3d world_from_base(YawRotation(base.yaw),
+                                Eigen::Vector3d(base.x, base.y, 0.0));
+  return world_from_base * base_from_cam;
+}
+
+Dataset LoadDataset(const fs::path& root, const DatasetOptions& options) {
+  options.Check();
+  if (!fs::is_directory(root)) {
+    throw InputError(root.string() + ": dataset directory not found");
+  }
+  Dataset ds;
+  ds.root = fs::absolute(root);
+  ds.camera = ReadCameraYaml(root / "camera.yaml");
+  const std::vector<RgbEntry> rgb = ReadRgbList(root);
+
+  const fs::path odom_path = root / "odometry.txt";
+  const fs::path odom2d_path = root / "odometry2d.txt";
+  std::vector<TimedPose> odometry;
+  std::vector<std::pair<double, Pose2d>> odometry2d;
+  if (fs::exists(odom2d_path)) {
+    ds.base_from_cam = ReadCameraMountYaml(root / "camera_mount.yaml");
+    odometry2d = ReadOdometry2d(odom2d_path);
+    for (const auto& [t, p] : odometry2d) {
+      odometry.push_back({t, WorldFromCamOfBase(p, *ds.base_from_cam)});
+    }
+  }
+  // odometry.txt, when present, gives the full 6-DoF camera odometry and
+  // takes precedence for the 3D pose; odometry2d stays available.
+  if (fs::exists(odom_path)) {
+    odometry = ReadTumTrajectory(odom_path);
+  } else if (odometry.empty()) {
+    throw InputError(root.string() +
+                     ": no odometry (need odometry.txt, or odometry2d.txt "
+                     "with camera_mount.yaml)");
+  }
+  std::vector<TimedPose> groundtruth;
+  const fs::path gt_path = root / "groundtruth.txt";
+  if (options.load_groundtruth && fs::exists(gt_path)) {
+    groundtruth = ReadTumTrajectory(gt_path);
+    ds.has_groundtruth = true;
+  }
+
+  const size_t first = static_cast<size_t>(options.first_frame);
+  if (first >= rgb.size()) {
+    throw InputError((root / "rgb.txt").string() + ": first_frame " +
+                     std::to_string(first) + " but only " +
+                     std::to_string(rgb.size()) + " frames listed");
+  }
+  size_t last = rgb.size();
+  if (options.num_frames > 0) {
+    last = std::min(last, first + static_cast<size_t>(options.num_frames));
+  }
+  for (size_t i = first; i < last; ++i) {
+    DatasetFrame f;
+    f.timestamp = rgb[i].timestamp;
+    f.image_path = fs::absolute(rgb[i].path);
+    if (!InterpolatePose(odometry, f.timestamp, options.max_odometry_gap,
+                         &f.odometry_world_from_cam)) {
+      throw InputError((root / "rgb.txt").string(), rgb[i].line,
+                       "no odometry for frame at t=" +
+                           std::to_string(f.timestamp) +
+                           " (outside the odometry or in a gap larger than " +
+                           std::to_string(options.max_odometry_gap) + " s)");
+    }
+    if (!odometry2d.empty()) {
+      // Interpolate the planar pose too (yaw unwrapped across the pair).
+      auto it = std::lower_bound(
+          odometry2d.begin(), odometry2d.end(), f.timestamp - 1e-6,
+          [](const auto& p, double t) { return p.first < t; });
+      if (it != odometry2d.end()) {
+        if (std::abs(it->first - f.timestamp) <= 1e-6 ||
+            it == odometry2d.begin()) {
+          f.odometry_base = it->second;
+        } else {
+          const auto& a = *std::prev(it);
+          const auto& b = *it;
+          const double s = (f.timestamp - a.first) / (b.first - a.first);
+          const double dyaw = std::remainder(b.second.yaw - a.second.yaw,
+                                             2.0 * M_PI);
+          f.odometry_base = Pose2d{
+              a.second.x + s * (b.second.x - a.second.x),
+              a.second.y + s * (b.second.y - a.second.y),
+              a.second.yaw + s * dyaw};
+        }
+      }
+    }
+    if (ds.has_groundtruth) {
+      Rigid3d gt;
+      if (InterpolatePose(groundtruth, f.timestamp, options.max_odometry_gap,
+                          &gt)) {
+        f.groundtruth_world_from_cam = gt;
+      }
+    }
+    ds.frames.push_back(f);
+  }
+  return ds;
+}
+
+cv::Mat Dataset::LoadImage(size_t i, bool color) const {
+  const fs::path& path = frames.at(i).image_path;
+  cv::Mat image = cv::imread(path.string(), color ? cv::IMREAD_COLOR
+                                                  : cv::IMREAD_GRAYSCALE);
+  if (image.empty()) {
+    throw InputError(path.string() + ": cannot read image");
+  }
+  if (image.cols != camera.width || image.rows != camera.height) {
+    throw InputError(path.string() + ": image is " +
+                     std::to_string(image.cols) + "x" +
+                     std::to_string(image.rows) + " but camera.yaml says " +
+                     std::to_string(camera.width) + "x" +
+                     std::to_string(camera.height));
+  }
+  return image;
+}
+
+}  // namespace monomap

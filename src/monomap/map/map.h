@@ -1,0 +1,90 @@
+// Data types shared by the stages. No algorithms here: stages in
+// tracking/, triangulation/, planes/, texture/, rendering/ read and write
+// these types and talk to each other only through them.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include "monomap/camera/camera.h"
+#include "monomap/geometry/plane.h"
+#include "monomap/geometry/rigid3.h"
+
+namespace monomap {
+
+using FeatureId = int64_t;
+
+// One sighting of a tracked feature: frame index into the dataset and the
+// raw (distorted) pixel position, pixel centres at integer coordinates.
+struct Observation {
+  int frame = 0;
+  Eigen::Vector2d px = Eigen::Vector2d::Zero();
+};
+
+// A feature tracked by KLT over consecutive frames. The id is unique over
+// the whole sequence and never reused.
+struct Track {
+  FeatureId id = 0;
+  std::vector<Observation> observations;  // sorted by frame
+};
+
+// A triangulated 3D point, carrying the id of its track.
+struct Landmark {
+  FeatureId id = 0;
+  Eigen::Vector3d x_in_world = Eigen::Vector3d::Zero();
+  Eigen::Vector3f color = Eigen::Vector3f::Zero();  // RGB in [0, 255]
+  int num_observations = 0;
+  double mean_reprojection_error_px = 0.0;
+  double triangulation_angle_deg = 0.0;
+  int plane_id = -1;  // index of the plane it lies on, -1 if none
+};
+
+// A timestamped camera pose.
+struct TimedPose {
+  double timestamp = 0.0;
+  Rigid3d world_from_cam;
+};
+
+// A feature on a plane: 3D point and where it lies in the plane texture.
+struct PlaneFeature {
+  FeatureId id = 0;
+  Eigen::Vector3d x_in_world = Eigen::Vector3d::Zero();
+  Eigen::Vector2d texture_px = Eigen::Vector2d::Zero();  // (column, row)
+};
+
+// A bounded plane with its texture. The centre of texture pixel (c, r)
+// shows frame.ToWorld(((c + 0.5) / pixels_per_meter,
+// (r + 0.5) / pixels_per_meter)).
+struct TexturedPlane {
+  int id = 0;
+  Plane plane;
+  PlaneFrame frame;
+  double pixels_per_meter = 0.0;
+  // BGRA, 8 bit; alpha 0 where no image saw the plane.
+  cv::Mat texture;
+  // Extent as a polygon of (s, t) plane coordinates in metres.
+  std::vector<Eigen::Vector2d> polygon;
+  std::vector<PlaneFeature> features;
+
+  // World point -> texture pixel coordinates (column, row) and back.
+  Eigen::Vector2d TextureFromWorld(const Eigen::Vector3d& x) const {
+    return frame.ToPlane(x) * pixels_per_meter - Eigen::Vector2d(0.5, 0.5);
+  }
+  Eigen::Vector3d WorldFromTexture(const Eigen::Vector2d& px) const {
+    return frame.ToWorld((px + Eigen::Vector2d(0.5, 0.5)) / pixels_per_meter);
+  }
+};
+
+// The whole map: what `monomap build` writes and `render`/`localize` read.
+struct Map {
+  Camera camera;
+  std::vector<TexturedPlane> planes;
+  std::vector<Landmark> landmarks;
+  std::vector<TimedPose> trajectory;  // refined world_from_cam per frame
+};
+
+}  // namespace monomap
