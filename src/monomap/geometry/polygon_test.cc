@@ -1,0 +1,26 @@
+#include "monomap/geometry/polygon.h"
+
+#include <gtest/gtest.h>
+
+namespace monomap {
+namespace {
+
+TEST(Polygon, HullAreaAndInside) {
+  std::vector<Eigen::Vector2d> pts = {{0, 0}, {2, 0}, {2, 1}, {0, 1},
+                                      {1, 0.5}, {0.5, 0.2}, {2, 0}};
+  const Polygon2d hull = ConvexHull(pts);
+  EXPECT_EQ(hull.size(), 4u);
+  EXPECT_NEAR(PolygonArea(hull), 2.0, 1e-12);
+  EXPECT_TRUE(PointInPolygon(hull, {1.0, 0.5}));
+  EXPECT_FALSE(PointInPolygon(hull, {2.5, 0.5}));
+  // An L shape: the notch is outside.
+  const Polygon2d l = {{0, 0}, {2, 0}, {2, 1}, {1, 1}, {1, 2}, {0, 2}};
+  EXPECT_TRUE(PointInPolygon(l, {0.5, 1.5}));
+  EXPECT_FALSE(PointInPolygon(l, {1.5, 1.5}));
+  Eigen::Vector2d lo, hi;
+  PolygonBounds(l, &lo, &hi);
+  EXPECT_EQ(hi, Eigen::Vector2d(2, 2));
+}
+
+}  // namespace
+}  // namespace monomap
