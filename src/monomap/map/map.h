@@ -12,6 +12,7 @@
 
 #include "monomap/camera/camera.h"
 #include "monomap/geometry/plane.h"
+#include "monomap/geometry/polygon.h"
 #include "monomap/geometry/rigid3.h"
 
 namespace monomap {
@@ -40,7 +41,24 @@ struct Landmark {
   int num_observations = 0;
   double mean_reprojection_error_px = 0.0;
   double triangulation_angle_deg = 0.0;
+  // Mean distance (m) from the observing camera centres: depth uncertainty
+  // grows with it, so plane fitting scales its inlier threshold by it.
+  double mean_depth_m = 0.0;
   int plane_id = -1;  // index of the plane it lies on, -1 if none
+};
+
+// A plane found among the landmarks (stage 3), before it has a texture.
+struct PlaneSegment {
+  int id = 0;
+  Plane plane;
+  // In-plane frame; inlier_st are the inliers' coordinates in it.
+  PlaneFrame frame;
+  std::vector<FeatureId> inlier_ids;
+  std::vector<Eigen::Vector2d> inlier_st;
+  // Bounded extent in (s, t) plane coordinates (metres).
+  Polygon2d polygon;
+  // RMS point-to-plane distance of the inliers (m).
+  double rms_distance_m = 0.0;
 };
 
 // A timestamped camera pose.
@@ -67,7 +85,7 @@ struct TexturedPlane {
   // BGRA, 8 bit; alpha 0 where no image saw the plane.
   cv::Mat texture;
   // Extent as a polygon of (s, t) plane coordinates in metres.
-  std::vector<Eigen::Vector2d> polygon;
+  Polygon2d polygon;
   std::vector<PlaneFeature> features;
 
   // World point -> texture pixel coordinates (column, row) and back.
