@@ -23,4 +23,11 @@ std::vector<Eigen::Vector3d> ReadPlyPoints(const std::filesystem::path& path);
 void WriteLandmarksPly(const std::filesystem::path& path,
                        const std::vector<Landmark>& landmarks);
 
+// Reads landmarks from a PLY vertex element: x y z are required; red green
+// blue, feature_id and plane are read when present (otherwise color 0,
+// id = vertex index, plane_id = -1). Fields that PLY does not hold
+// (observation counts, errors, depth) are left at their defaults. Throws
+// InputError naming the file on anything malformed or truncated.
+std::vector<Landmark> ReadLandmarksPly(const std::filesystem::path& path);
+
 }  // namespace monomap

@@ -1,0 +1,171 @@
+#include "monomap/io/gltf.h"
+
+#include <gtest/gtest.h>
+
+#include <cstring>
+
+#include <opencv2/imgproc.hpp>
+#include <tiny_gltf.h>
+
+#include "monomap/util/error.h"
+
+namespace monomap {
+namespace {
+namespace fs = std::filesystem;
+
+double TriangleArea(const Polygon2d& p, const Eigen::Vector3i& t) {
+  const Eigen::Vector2d a = p[t[1]] - p[t[0]], b = p[t[2]] - p[t[0]];
+  return 0.5 * (a.x() * b.y() - a.y() * b.x());
+}
+
+// Checks n - 2 counter-clockwise triangles covering the polygon's area.
+void ExpectTriangulation(const Polygon2d& polygon) {
+  const auto triangles = TriangulatePolygon(polygon);
+  ASSERT_EQ(triangles.size(), polygon.size() - 2);
+  double area = 0;
+  for (const auto& t : triangles) {
+    EXPECT_GE(TriangleArea(polygon, t), -1e-15);
+    area += TriangleArea(polygon, t);
+    // Centroid inside: no triangle covers a notch.
+    const Eigen::Vector2d c =
+        (polygon[t[0]] + polygon[t[1]] + polygon[t[2]]) / 3.0;
+    if (TriangleArea(polygon, t) > 1e-12) {
+      EXPECT_TRUE(PointInPolygon(polygon, c));
+    }
+  }
+  EXPECT_NEAR(area, std::abs(PolygonArea(polygon)), 1e-12);
+}
+
+TEST(GltfTest, TriangulatesConvexAndNonConvexPolygons) {
+  ExpectTriangulation({{0, 0}, {1, 0}, {1, 1}, {0, 1}});
+  // L shape, both orientations: a fan from vertex 0 would cover the notch.
+  Polygon2d l = {{1, 1}, {0.2, 1}, {0.2, 0.2}, {1, 0.2}, {1, 0}, {0, 0},
+                 {0, 2}, {1, 2}};
+  ExpectTriangulation(l);
+  std::reverse(l.begin(), l.end());
+  ExpectTriangulation(l);
+  // Comb with collinear vertices.
+  ExpectTriangulation({{0, 0}, {3, 0}, {3, 1}, {2.5, 1}, {2.5, 0.2}, {2, 0.2},
+                       {2, 1}, {1, 1}, {1, 0.5}, {0.5, 0.5}, {0, 0.5}});
+  EXPECT_TRUE(TriangulatePolygon({{0, 0}, {1, 0}}).empty());
+}
+
+template <typename T>
+std::vector<T> AccessorValues(const tinygltf::Model& model, int index,
+                              int components) {
+  const tinygltf::Accessor& accessor = model.accessors.at(index);
+  const tinygltf::BufferView& view = model.bufferViews.at(accessor.bufferView);
+  const tinygltf::Buffer& buffer = model.buffers.at(view.buffer);
+  std::vector<T> values(accessor.count * components);
+  EXPECT_LE(view.byteOffset + accessor.byteOffset + values.size() * sizeof(T),
+            buffer.data.size());
+  std::memcpy(values.data(),
+              buffer.data.data() + view.byteOffset + accessor.byteOffset,
+              values.size() * sizeof(T));
+  return values;
+}
+
+TEST(GltfTest, GlbRoundTripsThroughTinyGltf) {
+  Map map;
+  for (int i = 0; i < 2; ++i) {
+    TexturedPlane p;
+    p.id = 4 + i;
+    p.plane.normal = i == 0 ? Eigen::Vector3d::UnitZ()
+                            : Eigen::Vector3d(0.3, -1, 0.2).normalized();
+    p.plane.offset = i == 0 ? 0.0 : 1.5;
+    p.frame = MakePlaneFrame(p.plane, {1, 2, 3}, {1, 0, 0});
+    p.pixels_per_meter = 50 + 25 * i;
+    p.texture = cv::Mat(20 + i, 30 - i, CV_8UC4);
+    cv::randu(p.texture, 0, 256);
+    p.polygon = i == 0 ? Polygon2d{{0, 0}, {0.6, 0}, {0.6, 0.4}, {0, 0.4}}
+                       : Polygon2d{{0, 0}, {0.3, 0}, {0.3, 0.1}, {0.1, 0.1},
+                                   {0.1, 0.25}, {0, 0.25}};
+    map.planes.push_back(p);
+  }
+  const fs::path path = fs::temp_directory_path() / "monomap_gltf_test.glb";
+  WriteMapGlb(path, map);
+
+  tinygltf::TinyGLTF loader;
+  tinygltf::Model model;
+  std::string error, warning;
+  ASSERT_TRUE(loader.LoadBinaryFromFile(&model, &error, &warning, path.string()))
+      << error;
+  EXPECT_TRUE(error.empty()) << error;
+  EXPECT_EQ(model.asset.version, "2.0");
+  ASSERT_EQ(model.scenes.size(), 1u);
+  EXPECT_EQ(model.scenes[0].nodes.size(), 2u);
+  ASSERT_EQ(model.nodes.size(), 2u);
+  ASSERT_EQ(model.meshes.size(), 2u);
+  ASSERT_EQ(model.materials.size(), 2u);
+  ASSERT_EQ(model.textures.size(), 2u);
+  ASSERT_EQ(model.images.size(), 2u);
+  ASSERT_EQ(model.buffers.size(), 1u);
+
+  for (int i = 0; i < 2; ++i) {
+    const TexturedPlane& plane = map.planes[i];
+    const tinygltf::Node& node = model.nodes[i];
+    EXPECT_EQ(node.name, "plane_" + std::to_string(plane.id));
+    const tinygltf::Primitive& primitive = model.meshes.at(node.mesh).primitives.at(0);
+    EXPECT_EQ(primitive.mode, TINYGLTF_MODE_TRIANGLES);
+    const tinygltf::Material& material = model.materials.at(primitive.material);
+    EXPECT_TRUE(material.doubleSided);
+    const int texture = material.pbrMetallicRoughness.baseColorTexture.index;
+    const tinygltf::Image& image =
+        model.images.at(model.textures.at(texture).source);
+    EXPECT_EQ(image.mimeType, "image/png");
+    EXPECT_GE(image.bufferView, 0);  // embedded, not a file
+    // tinygltf decodes the PNG to RGBA: must be the BGRA texture exactly.
+    ASSERT_EQ(image.width, plane.texture.cols);
+    ASSERT_EQ(image.height, plane.texture.rows);
+    ASSERT_EQ(image.component, 4);
+    cv::Mat rgba(image.height, image.width, CV_8UC4,
+                 const_cast<unsigned char*>(image.image.data()));
+    cv::Mat bgra;
+    cv::cvtColor(rgba, bgra, cv::COLOR_RGBA2BGRA);
+    EXPECT_EQ(cv::norm(bgra, plane.texture, cv::NORM_INF), 0.0);
+
+    const size_t n = plane.polygon.size();
+    const auto positions =
+        AccessorValues<float>(model, primitive.attributes.at("POSITION"), 3);
+    const auto texcoords =
+        AccessorValues<float>(model, primitive.attributes.at("TEXCOORD_0"), 2);
+    const auto indices = AccessorValues<uint32_t>(model, primitive.indices, 1);
+    ASSERT_EQ(positions.size(), 3 * n);
+    ASSERT_EQ(texcoords.size(), 2 * n);
+    EXPECT_EQ(indices.size(), 3 * (n - 2));
+    double max_position_error = 0, max_uv_error = 0;
+    for (size_t k = 0; k < n; ++k) {
+      const Eigen::Vector3d x = plane.frame.ToWorld(plane.polygon[k]);
+      max_position_error = std::max(
+          max_position_error,
+          (Eigen::Vector3d(positions[3 * k], positions[3 * k + 1],
+                           positions[3 * k + 2]) - x).norm());
+      EXPECT_LT(std::abs(plane.plane.SignedDistance(x)), 1e-12);
+      // The texel centre convention: pixel (c, r) centre at uv
+      // ((c + 0.5) / width, (r + 0.5) / height).
+      const Eigen::Vector2d px = plane.TextureFromWorld(x);
+      const Eigen::Vector2d uv((px.x() + 0.5) / plane.texture.cols,
+                               (px.y() + 0.5) / plane.texture.rows);
+      max_uv_error = std::max(
+          max_uv_error,
+          (Eigen::Vector2d(texcoords[2 * k], texcoords[2 * k + 1]) - uv).norm());
+    }
+    EXPECT_LT(max_position_error, 1e-6);
+    EXPECT_LT(max_uv_error, 1e-6);
+    for (uint32_t index : indices) EXPECT_LT(index, n);
+  }
+}
+
+TEST(GltfTest, EmptyMapIsAValidGlb) {
+  const fs::path path = fs::temp_directory_path() / "monomap_gltf_empty.glb";
+  WriteMapGlb(path, Map());
+  tinygltf::TinyGLTF loader;
+  tinygltf::Model model;
+  std::string error, warning;
+  EXPECT_TRUE(loader.LoadBinaryFromFile(&model, &error, &warning, path.string()))
+      << error;
+  EXPECT_TRUE(model.nodes.empty());
+}
+
+}  // namespace
+}  // namespace monomap

@@ -1,0 +1,193 @@
+#include "monomap/io/ply.h"
+
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <fstream>
+#include <random>
+
+#include "monomap/util/error.h"
+#include "monomap/util/file.h"
+
+namespace monomap {
+namespace {
+namespace fs = std::filesystem;
+
+fs::path TempFile(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / "monomap_ply";
+  fs::create_directories(dir);
+  return dir / name;
+}
+
+void WriteBytes(const fs::path& path, const std::string& bytes) {
+  std::ofstream(path, std::ios::binary) << bytes;
+}
+
+template <typename T>
+void Append(std::string* out, T value) {
+  char buf[sizeof(T)];
+  std::memcpy(buf, &value, sizeof(T));
+  out->append(buf, sizeof(T));
+}
+
+std::string ErrorOf(const fs::path& path) {
+  try {
+    ReadPlyPoints(path);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+std::vector<Landmark> RandomLandmarks(int n) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> x(-20, 20);
+  std::uniform_int_distribution<int> c(0, 255);
+  std::vector<Landmark> landmarks(n);
+  for (int i = 0; i < n; ++i) {
+    landmarks[i].id = 1000 + 3 * i;
+    landmarks[i].x_in_world = {x(rng), x(rng), x(rng)};
+    landmarks[i].color = Eigen::Vector3f(c(rng), c(rng), c(rng));
+    landmarks[i].plane_id = i % 4 - 1;
+  }
+  return landmarks;
+}
+
+TEST(PlyTest, LandmarksRoundTrip) {
+  const auto landmarks = RandomLandmarks(500);
+  const fs::path path = TempFile("landmarks.ply");
+  WriteLandmarksPly(path, landmarks);
+  // 23 bytes per vertex after the header.
+  const std::string data = ReadFileToString(path);
+  EXPECT_EQ(data.size() - (data.find("end_header\n") + 11), 500u * 23u);
+
+  const auto points = ReadPlyPoints(path);
+  ASSERT_EQ(points.size(), landmarks.size());
+  double max_error = 0;
+  for (size_t i = 0; i < points.size(); ++i) {
+    max_error = std::max(
+        max_error, (points[i] - landmarks[i].x_in_world).lpNorm<Eigen::Infinity>());
+  }
+  EXPECT_LT(max_error, 2e-6);  // float precision at |x| <= 20
+
+  const auto read = ReadLandmarksPly(path);
+  ASSERT_EQ(read.size(), landmarks.size());
+  for (size_t i = 0; i < read.size(); ++i) {
+    EXPECT_EQ(read[i].id, landmarks[i].id);
+    EXPECT_EQ(read[i].plane_id, landmarks[i].plane_id);
+    EXPECT_EQ(read[i].color, landmarks[i].color);
+  }
+
+  WriteLandmarksPly(path, {});
+  EXPECT_TRUE(ReadPlyPoints(path).empty());
+}
+
+TEST(PlyTest, ReadsAsciiWithOtherPropertiesAndElements) {
+  const fs::path path = TempFile("ascii.ply");
+  WriteBytes(path,
+             "ply\r\nformat ascii 1.0\r\ncomment made by hand\r\n"
+             "element camera 1\r\nproperty float focal\r\n"
+             "element vertex 3\r\nproperty uchar red\r\nproperty double x\r\n"
+             "property float nx\r\nproperty double y\r\nproperty double z\r\n"
+             "property list uchar int ring\r\n"
+             "element face 1\r\nproperty list uchar int vertex_indices\r\n"
+             "end_header\r\n"
+             "500.5\r\n"
+             "255 1.25 0.1 -2.5 3e2 2 7 8\r\n"
+             "0 -0.125 0 0.5 1e-3 0\r\n"
+             "1 4 0 5 6 1 9\r\n"
+             "3 0 1 2\r\n");
+  const auto points = ReadPlyPoints(path);
+  ASSERT_EQ(points.size(), 3u);
+  EXPECT_EQ(points[0], Eigen::Vector3d(1.25, -2.5, 300));
+  EXPECT_EQ(points[1], Eigen::Vector3d(-0.125, 0.5, 1e-3));
+  EXPECT_EQ(points[2], Eigen::Vector3d(4, 5, 6));
+
+  // A short row is truncation, a bad token is named.
+  WriteBytes(path,
+             "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\n"
+             "property float y\nproperty float z\nend_header\n1 2 3\n4 5\n");
+  EXPECT_NE(ErrorOf(path).find("truncated"), std::string::npos);
+  WriteBytes(path,
+             "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n"
+             "property float y\nproperty float z\nend_header\n1 2 z3\n");
+  EXPECT_NE(ErrorOf(path).find("'z3'"), std::string::npos);
+}
+
+TEST(PlyTest, ReadsBinaryDoublesAndSkipsOtherTypes) {
+  std::string ply =
+      "ply\nformat binary_little_endian 1.0\n"
+      "element header_info 2\nproperty list uchar short ids\n"
+      "element vertex 2\nproperty short s\nproperty double x\n"
+      "property double y\nproperty uint u\nproperty double z\n"
+      "property char c\nend_header\n";
+  Append<uint8_t>(&ply, 2);
+  Append<int16_t>(&ply, 1);
+  Append<int16_t>(&ply, 2);
+  Append<uint8_t>(&ply, 0);
+  const double values[2][3] = {{0.1, -7e5, 3.0 / 7.0}, {1e-9, 2, -3}};
+  for (const auto& v : values) {
+    Append<int16_t>(&ply, -4);
+    Append<double>(&ply, v[0]);
+    Append<double>(&ply, v[1]);
+    Append<uint32_t>(&ply, 99);
+    Append<double>(&ply, v[2]);
+    Append<int8_t>(&ply, -1);
+  }
+  const fs::path path = TempFile("binary.ply");
+  WriteBytes(path, ply);
+  const auto points = ReadPlyPoints(path);
+  ASSERT_EQ(points.size(), 2u);
+  for (int i = 0; i < 2; ++i) {
+    EXPECT_EQ(points[i], Eigen::Vector3d(values[i][0], values[i][1],
+                                         values[i][2]));  // exact doubles
+  }
+  // One byte short.
+  WriteBytes(path, ply.substr(0, ply.size() - 1));
+  EXPECT_NE(ErrorOf(path).find("truncated"), std::string::npos);
+}
+
+TEST(PlyTest, RejectsTruncatedAndMalformedFiles) {
+  const fs::path path = TempFile("bad.ply");
+  WriteLandmarksPly(path, RandomLandmarks(10));
+  const std::string good = ReadFileToString(path);
+
+  WriteBytes(path, good.substr(0, good.size() - 5));
+  std::string error = ErrorOf(path);
+  EXPECT_NE(error.find("bad.ply"), std::string::npos) << error;
+  EXPECT_NE(error.find("truncated"), std::string::npos) << error;
+
+  WriteBytes(path, good.substr(0, good.find("end_header")));
+  EXPECT_NE(ErrorOf(path).find("no 'end_header'"), std::string::npos);
+
+  std::string big_endian = good;
+  big_endian.replace(big_endian.find("binary_little_endian"), 20,
+                     "binary_big_endian");
+  WriteBytes(path, big_endian);
+  EXPECT_NE(ErrorOf(path).find("unsupported PLY format"), std::string::npos);
+
+  WriteBytes(path, "PLY\n");
+  EXPECT_NE(ErrorOf(path).find("not a PLY file"), std::string::npos);
+
+  WriteBytes(path,
+             "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n"
+             "property float y\nend_header\n1 2\n");
+  EXPECT_NE(ErrorOf(path).find("no property 'z'"), std::string::npos);
+
+  WriteBytes(path,
+             "ply\nformat ascii 1.0\nelement vertex 1\nproperty float128 x\n"
+             "end_header\n1\n");
+  EXPECT_NE(ErrorOf(path).find("bad.ply:4:"), std::string::npos);
+
+  WriteBytes(path,
+             "ply\nformat binary_little_endian 1.0\n"
+             "element vertex 99999999999\nproperty float x\nproperty float y\n"
+             "property float z\nend_header\n");
+  EXPECT_NE(ErrorOf(path).find("truncated"), std::string::npos);
+
+  EXPECT_NE(ErrorOf(TempFile("missing.ply")).find("missing.ply"),
+            std::string::npos);
+}
+
+}  // namespace
+}  // namespace monomap
