@@ -1,0 +1,182 @@
+// Renders per second of rendering/Renderer on synthetic maps: a desk (one
+// 0.8 x 0.6 m plane, 1600x1200 texture) and a hallway (7 planes, 1024x1024
+// textures), at 80x60, 160x120 and 640x480, over a batch of 1000 poses,
+// single-threaded and with tbb::parallel_for (Renderer::RenderBatch).
+//
+//   build/bench/rendering_bench --benchmark_counters_tabular=true
+#include <cmath>
+#include <vector>
+
+#include <benchmark/benchmark.h>
+#include <opencv2/imgproc.hpp>
+
+#include "monomap/rendering/renderer.h"
+
+namespace monomap {
+namespace {
+
+using Eigen::Vector2d;
+using Eigen::Vector3d;
+
+constexpr int kBatch = 1000;
+
+Camera BaseCamera() {
+  Camera c;
+  c.width = 640;
+  c.height = 480;
+  c.fx = c.fy = 500;
+  c.cx = 319.5;
+  c.cy = 239.5;
+  return c;
+}
+
+Rigid3d LookAt(const Vector3d& centre, const Vector3d& target,
+               const Vector3d& up) {
+  const Vector3d z = (target - centre).normalized();
+  const Vector3d y = -(up - up.dot(z) * z).normalized();
+  const Vector3d x = y.cross(z);
+  Eigen::Matrix3d r;
+  r << x, y, z;
+  return Rigid3d(Eigen::Quaterniond(r), centre);
+}
+
+// Band-limited random texture with some sharp rectangles, opaque.
+cv::Mat RandomTexture(int cols, int rows, uint64_t seed) {
+  cv::RNG rng(seed);
+  cv::Mat noise(rows / 8, cols / 8, CV_32F);
+  rng.fill(noise, cv::RNG::UNIFORM, 0.0, 255.0);
+  cv::Mat grey;
+  cv::resize(noise, grey, cv::Size(cols, rows), 0, 0, cv::INTER_CUBIC);
+  grey.convertTo(grey, CV_8U);
+  for (int i = 0; i < 60; ++i) {
+    const int x = rng.uniform(0, cols), y = rng.uniform(0, rows);
+    cv::rectangle(grey, cv::Rect(x, y, rng.uniform(5, cols / 8),
+                                 rng.uniform(5, rows / 8)),
+                  cv::Scalar(rng.uniform(0, 256)), cv::FILLED);
+  }
+  cv::Mat bgra;
+  cv::cvtColor(grey, bgra, cv::COLOR_GRAY2BGRA);
+  return bgra;
+}
+
+TexturedPlane MakePlane(int id, const Vector3d& origin, const Vector3d& u,
+                        const Vector3d& v, double ppm, int cols, int rows,
+                        double extent_s, double extent_t) {
+  TexturedPlane p;
+  p.id = id;
+  p.frame.origin = origin;
+  p.frame.u_axis = u;
+  p.frame.v_axis = v;
+  p.plane.normal = u.cross(v);
+  p.plane.offset = -p.plane.normal.dot(origin);
+  p.pixels_per_meter = ppm;
+  p.texture = RandomTexture(cols, rows, 1000 + id);
+  p.polygon = {Vector2d(0, 0), Vector2d(extent_s, 0),
+               Vector2d(extent_s, extent_t), Vector2d(0, extent_t)};
+  return p;
+}
+
+struct Scene {
+  Renderer renderer;
+  std::vector<Rigid3d> poses;
+};
+
+Scene MakeDesk() {
+  std::vector<TexturedPlane> planes = {
+      MakePlane(0, Vector3d::Zero(), Vector3d::UnitX(), Vector3d::UnitY(),
+                2000, 1600, 1200, 0.8, 0.6)};
+  Scene scene{Renderer(planes), {}};
+  cv::RNG rng(7);
+  for (int i = 0; i < kBatch; ++i) {
+    const Vector3d centre(rng.uniform(0.1, 0.7), rng.uniform(-0.2, 0.4),
+                          rng.uniform(0.3, 0.6));
+    const Vector3d target(rng.uniform(0.25, 0.55), rng.uniform(0.2, 0.4), 0);
+    const double a = rng.uniform(0.0, 2 * M_PI);
+    scene.poses.push_back(
+        LookAt(centre, target, Vector3d(std::cos(a), std::sin(a), 0)));
+  }
+  return scene;
+}
+
+// Corridor along +x, 8 m long, 2 m wide (y in [-1, 1]), 2.5 m high; normals
+// face inwards.
+Scene MakeHallway() {
+  const double ppm = 256;  // 1024 texels = 4 m
+  std::vector<TexturedPlane> planes;
+  int id = 0;
+  for (double x0 : {0.0, 4.0}) {
+    // Floor (+z), left wall y = 1 (x cross z = -y), right wall y = -1
+    // (x cross -z = +y).
+    planes.push_back(MakePlane(id++, Vector3d(x0, -1, 0), Vector3d::UnitX(),
+                               Vector3d::UnitY(), ppm, 1024, 1024, 4, 2));
+    planes.push_back(MakePlane(id++, Vector3d(x0, 1, 0), Vector3d::UnitX(),
+                               Vector3d::UnitZ(), ppm, 1024, 1024, 4, 2.5));
+    planes.push_back(MakePlane(id++, Vector3d(x0, -1, 2.5), Vector3d::UnitX(),
+                               -Vector3d::UnitZ(), ppm, 1024, 1024, 4, 2.5));
+  }
+  // End wall x = 8 (y cross -z = -x).
+  planes.push_back(MakePlane(id++, Vector3d(8, -1, 2.5), Vector3d::UnitY(),
+                             -Vector3d::UnitZ(), ppm, 1024, 1024, 2, 2.5));
+  Scene scene{Renderer(planes), {}};
+  cv::RNG rng(11);
+  for (int i = 0; i < kBatch; ++i) {
+    const Vector3d centre(rng.uniform(0.5, 6.0), rng.uniform(-0.6, 0.6),
+                          rng.uniform(1.2, 1.7));
+    const double yaw = rng.uniform(-0.5, 0.5);
+    const double pitch = rng.uniform(-0.2, 0.2);
+    const Vector3d dir(std::cos(yaw) * std::cos(pitch),
+                       std::sin(yaw) * std::cos(pitch), std::sin(pitch));
+    scene.poses.push_back(LookAt(centre, centre + dir, Vector3d::UnitZ()));
+  }
+  return scene;
+}
+
+const Scene& GetScene(int which) {
+  static const Scene desk = MakeDesk();
+  static const Scene hallway = MakeHallway();
+  return which == 0 ? desk : hallway;
+}
+
+// Args: scene (0 desk, 1 hallway), render width (4:3), parallel (0/1).
+void BM_Render(benchmark::State& state) {
+  const Scene& scene = GetScene(static_cast<int>(state.range(0)));
+  const int width = static_cast<int>(state.range(1));
+  const bool parallel = state.range(2) != 0;
+  const Camera camera = BaseCamera().Scaled(width, width * 3 / 4);
+  std::vector<cv::Mat> greys(kBatch);
+  cv::Mat grey;
+  double foreground = 0;
+  for (auto _ : state) {
+    foreground = 0;
+    if (parallel) {
+      const std::vector<RenderStats> stats =
+          scene.renderer.RenderBatch(camera, scene.poses, &greys);
+      for (const RenderStats& s : stats) {
+        foreground += static_cast<double>(s.pixels_foreground) / s.pixels_total;
+      }
+    } else {
+      for (const Rigid3d& pose : scene.poses) {
+        const RenderStats s = scene.renderer.Render(camera, pose, &grey);
+        foreground += static_cast<double>(s.pixels_foreground) / s.pixels_total;
+      }
+    }
+    benchmark::ClobberMemory();
+  }
+  state.counters["renders_per_s"] = benchmark::Counter(
+      static_cast<double>(kBatch) * state.iterations(),
+      benchmark::Counter::kIsRate);
+  state.counters["foreground"] = foreground / kBatch;
+  state.SetLabel(std::string(state.range(0) == 0 ? "desk" : "hallway") +
+                 (parallel ? " tbb" : " 1-thread"));
+}
+
+BENCHMARK(BM_Render)
+    ->ArgNames({"scene", "width", "parallel"})
+    ->ArgsProduct({{0, 1}, {80, 160, 640}, {0, 1}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+}  // namespace
+}  // namespace monomap
+
+BENCHMARK_MAIN();
