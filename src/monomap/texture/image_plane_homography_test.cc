@@ -1,0 +1,143 @@
+#include "monomap/texture/image_plane_homography.h"
+
+#include <cmath>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "monomap/geometry/homography.h"
+#include "monomap/texture/test_scene.h"
+#include "monomap/util/error.h"
+
+namespace monomap {
+namespace {
+
+Camera TestCamera() {
+  Camera c;
+  c.width = 320;
+  c.height = 240;
+  c.fx = 280;
+  c.fy = 282;
+  c.cx = 158.3;
+  c.cy = 121.1;
+  c.distortion = {-0.25, 0.08, 0.001, -0.0008, 0.0};
+  return c;
+}
+
+std::vector<Rigid3d> TestPoses(int n) {
+  std::vector<Rigid3d> poses;
+  for (int i = 0; i < n; ++i) {
+    const double a = 6.283185307179586 * i / n;
+    const Eigen::Vector3d eye(0.3 + 0.12 * std::cos(a),
+                              0.2 + 0.08 * std::sin(a),
+                              0.5 + 0.05 * std::sin(2 * a));
+    const Eigen::Vector3d target(0.3 + 0.03 * std::sin(a), 0.2, 0.0);
+    poses.push_back(testing::LookAt(eye, target, Eigen::Vector3d::UnitY()));
+  }
+  return poses;
+}
+
+TEST(ImagePlaneHomographyTest, MatchesAnalyticProjectionForExactPoses) {
+  const Camera camera = TestCamera();
+  const auto poses = TestPoses(10);
+  std::vector<PlaneSegment> segments = {
+      testing::HorizontalRectangle(3, 0.0, 0.0, 0.0, 0.6, 0.4)};
+  std::vector<Landmark> landmarks;
+  std::vector<Track> tracks;
+  testing::MakePlaneFeatures(camera, poses, 50, 100, 7, &segments[0],
+                             &landmarks, &tracks);
+  std::vector<ImagePlaneHomography> hs;
+  const HomographyReport report = ComputeImagePlaneHomographies(
+      camera, poses, segments, landmarks, tracks, HomographyOptions(), &hs);
+  ASSERT_EQ(report.num_homographies, 10);
+  EXPECT_EQ(report.num_checked, 10);
+  EXPECT_EQ(report.num_refined, 0);
+  EXPECT_LT(report.median_residual_before_px, 1e-6);
+
+  std::mt19937 rng(1);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const Eigen::Matrix3d k = camera.K();
+  for (const auto& h : hs) {
+    EXPECT_EQ(h.plane_id, 3);
+    EXPECT_GT(h.visible_fraction, 0.5);
+    EXPECT_GT(h.num_features, 20);
+    EXPECT_LT(h.before.max, 1e-6);
+    EXPECT_FALSE(h.refined);
+    // Plane resolution is about f / height.
+    EXPECT_NEAR(h.pixels_per_meter, 280.0 / 0.5, 150.0);
+    const Rigid3d cam_from_world = poses[h.frame].Inverse();
+    double max_err = 0.0;
+    for (int i = 0; i < 100; ++i) {
+      const Eigen::Vector2d st(0.6 * u(rng), 0.4 * u(rng));
+      const Eigen::Vector3d x = cam_from_world * segments[0].frame.ToWorld(st);
+      const Eigen::Vector2d expected = (k * x).hnormalized();
+      max_err = std::max(
+          max_err, (ApplyHomography(h.pixel_from_plane, st) - expected).norm());
+    }
+    EXPECT_LT(max_err, 1e-6) << "frame " << h.frame;
+  }
+}
+
+TEST(ImagePlaneHomographyTest, RefinesWhenPoseIsOff) {
+  const Camera camera = TestCamera();
+  const auto poses = TestPoses(8);
+  std::vector<PlaneSegment> segments = {
+      testing::HorizontalRectangle(0, 0.0, 0.0, 0.0, 0.6, 0.4)};
+  std::vector<Landmark> landmarks;
+  std::vector<Track> tracks;
+  // Observations from the true poses, homographies from perturbed ones.
+  testing::MakePlaneFeatures(camera, poses, 60, 0, 3, &segments[0],
+                             &landmarks, &tracks);
+  std::vector<Rigid3d> wrong = poses;
+  for (size_t i = 0; i < wrong.size(); ++i) {
+    wrong[i] = wrong[i] *
+               Rigid3d(QuaternionFromRotationVector({0.008, -0.006, 0.004}),
+                       Eigen::Vector3d(0.01, -0.005, 0.0));
+  }
+  std::vector<ImagePlaneHomography> hs;
+  const HomographyReport report = ComputeImagePlaneHomographies(
+      camera, wrong, segments, landmarks, tracks, HomographyOptions(), &hs);
+  ASSERT_EQ(report.num_homographies, 8);
+  EXPECT_EQ(report.num_refined, 8);
+  EXPECT_GT(report.median_residual_before_px, 2.0);
+  EXPECT_LT(report.median_residual_after_px, 0.01);
+  for (const auto& h : hs) {
+    EXPECT_TRUE(h.refined);
+    EXPECT_LT(h.after.max, 0.05);
+    EXPECT_LT(h.residual_after_px, h.residual_before_px);
+  }
+
+  // Without refinement the residual stays.
+  HomographyOptions no_refine;
+  no_refine.refine = false;
+  const HomographyReport r2 = ComputeImagePlaneHomographies(
+      camera, wrong, segments, landmarks, tracks, no_refine, &hs);
+  EXPECT_EQ(r2.num_refined, 0);
+  EXPECT_GT(r2.median_residual_after_px, 2.0);
+}
+
+TEST(ImagePlaneHomographyTest, SkipsPlanesOutOfView) {
+  const Camera camera = TestCamera();
+  const auto poses = TestPoses(4);
+  // A plane far to the side and one behind the cameras.
+  std::vector<PlaneSegment> segments = {
+      testing::HorizontalRectangle(0, 5.0, 5.0, 0.0, 0.3, 0.3),
+      testing::HorizontalRectangle(1, 0.0, 0.0, 1.5, 0.6, 0.4)};
+  std::vector<ImagePlaneHomography> hs;
+  const HomographyReport report = ComputeImagePlaneHomographies(
+      camera, poses, segments, {}, {}, HomographyOptions(), &hs);
+  EXPECT_EQ(report.num_homographies, 0);
+}
+
+TEST(ImagePlaneHomographyTest, OptionsCheck) {
+  HomographyOptions o;
+  EXPECT_NO_THROW(o.Check());
+  o.min_features_to_refine = 2;
+  EXPECT_THROW(o.Check(), OptionsError);
+  o = HomographyOptions();
+  o.min_visible_fraction = 1.5;
+  EXPECT_THROW(o.Check(), OptionsError);
+}
+
+}  // namespace
+}  // namespace monomap
