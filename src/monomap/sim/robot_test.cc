@@ -1,0 +1,135 @@
+#include "monomap/sim/robot.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "monomap/util/error.h"
+
+namespace monomap {
+namespace {
+
+double Drift(const std::vector<TimedPose2d>& a,
+             const std::vector<TimedPose2d>& b) {
+  return std::hypot(a.back().pose.x - b.back().pose.x,
+                    a.back().pose.y - b.back().pose.y);
+}
+
+TEST(RobotTest, PathIsSmoothAtConstantSpeed) {
+  for (const std::string& name : WorldNames()) {
+    SCOPED_TRACE(name);
+    const World w = MakeWorld(name, 1, 20.0);
+    const RobotPath path(w);
+    RobotPathOptions o;
+    const auto poses = SampleRobotPath(path, o);
+    EXPECT_GT(path.Length(), 5.0);
+    ASSERT_GT(poses.size(), 300u);
+    EXPECT_NEAR(poses[0].pose.x, w.path_keypoints[0].x(), 1e-9);
+    EXPECT_NEAR(poses[0].pose.y, w.path_keypoints[0].y(), 1e-9);
+    const double step = o.speed_mps / o.rate_hz;
+    double max_dyaw = 0, max_step_err = 0, max_ddyaw = 0, prev_dyaw = 0;
+    for (size_t k = 1; k < poses.size(); ++k) {
+      EXPECT_NEAR(poses[k].timestamp - poses[k - 1].timestamp, 1 / 30.0,
+                  1e-9);
+      const double d = std::hypot(poses[k].pose.x - poses[k - 1].pose.x,
+                                  poses[k].pose.y - poses[k - 1].pose.y);
+      max_step_err = std::max(max_step_err, std::abs(d - step) / step);
+      const double dyaw =
+          std::remainder(poses[k].pose.yaw - poses[k - 1].pose.yaw, 2 * M_PI);
+      max_dyaw = std::max(max_dyaw, std::abs(dyaw));
+      if (k > 1) max_ddyaw = std::max(max_ddyaw, std::abs(dyaw - prev_dyaw));
+      prev_dyaw = dyaw;
+      // The heading is the direction of motion.
+      EXPECT_LT(std::abs(std::remainder(
+                    std::atan2(poses[k].pose.y - poses[k - 1].pose.y,
+                               poses[k].pose.x - poses[k - 1].pose.x) -
+                        poses[k].pose.yaw,
+                    2 * M_PI)),
+                0.05);
+    }
+    EXPECT_LT(max_step_err, 0.02);
+    EXPECT_LT(max_dyaw, 0.05);     // < 1.5 rad/s
+    EXPECT_LT(max_ddyaw, 0.01);    // no heading jumps
+  }
+}
+
+TEST(RobotTest, MountLooksForwardAndSlightlyDown) {
+  CameraMountOptions o;
+  const Rigid3d base_from_cam = MakeCameraMount(o);
+  const Eigen::Matrix3d r = base_from_cam.RotationMatrix();
+  EXPECT_NEAR(r.determinant(), 1.0, 1e-12);
+  const Eigen::Vector3d z = r.col(2), x = r.col(0);
+  EXPECT_NEAR(z.z(), -std::sin(o.tilt_down_deg * M_PI / 180), 1e-12);
+  EXPECT_GT(z.x(), 0.98);
+  EXPECT_NEAR(x.y(), -1.0, 1e-12);  // camera x = base right
+  EXPECT_NEAR(base_from_cam.translation.z(), o.height_m, 1e-12);
+  o.height_m = 0.0;
+  EXPECT_THROW(MakeCameraMount(o), OptionsError);
+}
+
+TEST(RobotTest, NoiselessOdometryIsExact) {
+  const World w = MakeWorld("room", 1, 20.0);
+  const auto truth = SampleRobotPath(RobotPath(w), {});
+  const auto odom = SimulateOdometry(truth, OdometryNoiseOptions::None(), 3);
+  ASSERT_EQ(odom.size(), truth.size());
+  for (size_t k = 0; k < truth.size(); ++k) {
+    EXPECT_NEAR(odom[k].pose.x, truth[k].pose.x, 1e-9);
+    EXPECT_NEAR(odom[k].pose.y, truth[k].pose.y, 1e-9);
+    EXPECT_NEAR(std::remainder(odom[k].pose.yaw - truth[k].pose.yaw, 2 * M_PI),
+                0.0, 1e-9);
+  }
+}
+
+TEST(RobotTest, WheelRadiusErrorScalesDisplacement) {
+  const World w = MakeWorld("hallway", 1, 20.0);
+  const auto truth = SampleRobotPath(RobotPath(w), {});
+  OdometryNoiseOptions o = OdometryNoiseOptions::None();
+  o.wheel_radius_error = 0.01;
+  const auto odom = SimulateOdometry(truth, o, 3);
+  // With exact headings every step is 1% longer: the end point moves 1%
+  // of the start-to-end displacement.
+  const double disp = std::hypot(truth.back().pose.x - truth[0].pose.x,
+                                 truth.back().pose.y - truth[0].pose.y);
+  EXPECT_NEAR(Drift(truth, odom), 0.01 * disp, 1e-6);
+}
+
+TEST(RobotTest, DefaultDriftIsOneToFewPercent) {
+  for (const std::string& name : WorldNames()) {
+    const World w = MakeWorld(name, 1, 20.0);
+    const auto truth = SampleRobotPath(RobotPath(w), {});
+    const double length = PathLength(truth);
+    double sum = 0;
+    for (uint64_t seed = 1; seed <= 8; ++seed) {
+      const auto odom = SimulateOdometry(truth, {}, seed);
+      const double pct = 100.0 * Drift(truth, odom) / length;
+      SCOPED_TRACE(name + " seed " + std::to_string(seed));
+      EXPECT_GT(pct, 0.15);
+      EXPECT_LT(pct, 4.0);
+      sum += pct;
+    }
+    // Mean over seeds in the typical wheel-odometry band.
+    EXPECT_GT(sum / 8, 0.5);
+    EXPECT_LT(sum / 8, 3.0);
+  }
+  // Same seed, same odometry; different seed, different odometry.
+  const World w = MakeWorld("hallway", 1, 20.0);
+  const auto truth = SampleRobotPath(RobotPath(w), {});
+  const auto a = SimulateOdometry(truth, {}, 4);
+  const auto b = SimulateOdometry(truth, {}, 4);
+  const auto c = SimulateOdometry(truth, {}, 5);
+  EXPECT_EQ(a.back().pose.x, b.back().pose.x);
+  EXPECT_NE(a.back().pose.x, c.back().pose.x);
+}
+
+TEST(RobotTest, OptionsAreChecked) {
+  OdometryNoiseOptions o;
+  o.translation_noise = -1;
+  EXPECT_THROW(o.Check(), OptionsError);
+  RobotPathOptions p;
+  p.speed_mps = 0;
+  EXPECT_THROW(p.Check(), OptionsError);
+  EXPECT_THROW(RobotPath({{0, 0}}, false), OptionsError);
+}
+
+}  // namespace
+}  // namespace monomap

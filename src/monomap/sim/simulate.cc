@@ -1,0 +1,231 @@
+#include "monomap/sim/simulate.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <opencv2/imgcodecs.hpp>
+#include <sstream>
+
+#include "monomap/io/dataset.h"
+#include "monomap/io/map_format.h"
+#include "monomap/io/trajectory_io.h"
+#include "monomap/util/error.h"
+#include "monomap/util/file.h"
+#include "monomap/util/progress.h"
+
+namespace monomap {
+namespace fs = std::filesystem;
+
+void SimulationOptions::Check() const {
+  const auto names = WorldNames();
+  if (std::find(names.begin(), names.end(), world) == names.end()) {
+    MakeWorld(world, seed, 20.0);  // throws the error listing valid names
+  }
+  CheckOption(num_frames == -1 || num_frames > 0, "sim.num_frames",
+              "must be -1 (whole path) or > 0");
+  CheckOption(width >= 16 && height >= 16 && width <= 8192 && height <= 8192,
+              "sim.width/height", "must be in [16, 8192]");
+  CheckOption(focal_px_at_640 > 50 && focal_px_at_640 < 5000,
+              "sim.focal_px_at_640", "must be in (50, 5000)");
+  CheckOption(std::abs(k1) < 1.0 && std::abs(k2) < 1.0, "sim.k1/k2",
+              "must be within +-1");
+  CheckOption(texture_pixels_per_meter >= 20 &&
+                  texture_pixels_per_meter <= 2000,
+              "sim.texture_pixels_per_meter", "must be in [20, 2000]");
+  path.Check();
+  mount.Check();
+  odometry.Check();
+  render.Check();
+  effects.Check();
+  CheckOption(moving_object_start_fraction >= 0 &&
+                  moving_object_start_fraction <= 1,
+              "sim.moving_object_start_fraction", "must be in [0, 1]");
+  CheckOption(moving_object_duration_fraction > 0 &&
+                  moving_object_duration_fraction <= 1,
+              "sim.moving_object_duration_fraction", "must be in (0, 1]");
+  CheckOption(moving_object_radius_m > 0.01 && moving_object_radius_m < 2,
+              "sim.moving_object_radius_m", "must be in (0.01, 2)");
+  CheckOption(moving_object_distance_m > 0.2 && moving_object_distance_m < 20,
+              "sim.moving_object_distance_m", "must be in (0.2, 20)");
+  CheckOption(highlight_strength >= 0 && highlight_strength <= 255,
+              "sim.highlight_strength", "must be in [0, 255]");
+  CheckOption(highlight_radius_m > 0 && highlight_radius_m < 5,
+              "sim.highlight_radius_m", "must be in (0, 5)");
+}
+
+Camera MakeSimulationCamera(const SimulationOptions& options) {
+  // Same horizontal field of view at any width; square pixels; principal
+  // point at the centre (pixel centres at integers).
+  Camera c;
+  c.width = options.width;
+  c.height = options.height;
+  c.fx = c.fy = options.focal_px_at_640 * options.width / 640.0;
+  c.cx = (options.width - 1) * 0.5;
+  c.cy = (options.height - 1) * 0.5;
+  c.distortion = {options.k1, options.k2, 0.0, 0.0, 0.0};
+  return c;
+}
+
+namespace {
+
+std::string FormatOdometry2d(const std::vector<TimedPose2d>& poses) {
+  std::ostringstream out;
+  out << "# planar wheel odometry of the robot base: timestamp x y yaw\n";
+  char buf[160];
+  for (const TimedPose2d& p : poses) {
+    std::snprintf(buf, sizeof(buf), "%.6f %.9f %.9f %.9f\n", p.timestamp,
+                  p.pose.x, p.pose.y, p.pose.yaw);
+    out << buf;
+  }
+  return out.str();
+}
+
+std::vector<TimedPose> CameraPoses(const std::vector<TimedPose2d>& base,
+                                   const Rigid3d& base_from_cam) {
+  std::vector<TimedPose> out;
+  out.reserve(base.size());
+  for (const TimedPose2d& p : base) {
+    out.push_back({p.timestamp, WorldFromCamOfBase(p.pose, base_from_cam)});
+  }
+  return out;
+}
+
+}  // namespace
+
+SimulationReport Simulate(const SimulationOptions& options,
+                          const fs::path& out_dir) {
+  options.Check();
+  Timer timer;
+  SimulationReport report;
+  report.world = options.world;
+
+  const World world = MakeWorld(options.world, options.seed,
+                                options.texture_pixels_per_meter);
+  const Camera camera = MakeSimulationCamera(options);
+  const RobotPath path(world);
+  const std::vector<TimedPose2d> truth =
+      SampleRobotPath(path, options.path, options.num_frames);
+  const std::vector<TimedPose2d> odom =
+      SimulateOdometry(truth, options.odometry, options.seed);
+  const Rigid3d base_from_cam = MakeCameraMount(options.mount);
+  const std::vector<TimedPose> gt_cam = CameraPoses(truth, base_from_cam);
+  const std::vector<TimedPose> odom_cam = CameraPoses(odom, base_from_cam);
+
+  const int n = static_cast<int>(truth.size());
+  report.frames = n;
+  report.planes = static_cast<int>(world.planes.size());
+  report.texture_megabytes = world.TextureBytes() / 1e6;
+  report.path_length_m = PathLength(truth);
+  const Pose2d& a = truth.back().pose;
+  const Pose2d& b = odom.back().pose;
+  report.final_drift_m = std::hypot(a.x - b.x, a.y - b.y);
+  report.final_drift_percent =
+      report.path_length_m > 0
+          ? 100.0 * report.final_drift_m / report.path_length_m
+          : 0.0;
+  report.final_yaw_error_deg =
+      std::abs(std::remainder(a.yaw - b.yaw, 2.0 * M_PI)) * 180.0 / M_PI;
+
+  SceneRenderer renderer(camera, options.render);
+  for (const TexturedPlane& p : world.planes) renderer.AddPlane(p);
+  int object_index = -1;
+  if (options.moving_object) {
+    object_index = renderer.AddPlane(
+        MakeDiscObject(options.moving_object_radius_m,
+                       options.texture_pixels_per_meter,
+                       SimMixSeed(options.seed, 77)));
+    renderer.SetPlaneVisible(object_index, false);
+    report.moving_object_first_frame = std::min(
+        n - 1, static_cast<int>(options.moving_object_start_fraction * n));
+    report.moving_object_last_frame = std::min(
+        n - 1, report.moving_object_first_frame +
+                   std::max(0, static_cast<int>(
+                                   options.moving_object_duration_fraction * n) -
+                                   1));
+  }
+
+  AtomicDirectory dir(out_dir);
+  const fs::path root = dir.path();
+  fs::create_directories(root / "rgb");
+  WriteCameraYaml(root / "camera.yaml", camera, "monomap_sim_" + world.name);
+  WriteCameraMountYaml(root / "camera_mount.yaml", base_from_cam);
+  WriteFileAtomic(root / "odometry2d.txt", FormatOdometry2d(odom));
+  WriteTumTrajectory(root / "odometry.txt", odom_cam,
+                     "simulated wheel odometry composed with the mount");
+  WriteTumTrajectory(root / "groundtruth.txt", gt_cam,
+                     "simulated ground truth (" + world.name + ")");
+
+  // Half the horizontal field of view at the object distance: the object
+  // sweeps over the middle 70% of it (further out it would often hide
+  // behind nearby walls).
+  const double half_width =
+      options.moving_object_distance_m * (camera.width * 0.5) / camera.fx;
+  std::ostringstream rgb_list;
+  rgb_list << "# timestamp filename (simulated " << world.name << ")\n";
+  ProgressBar progress("simulate " + world.name, n, options.show_progress);
+  for (int i = 0; i < n; ++i) {
+    const Rigid3d& world_from_cam = gt_cam[i].world_from_cam;
+    if (object_index >= 0) {
+      const int f0 = report.moving_object_first_frame;
+      const int f1 = report.moving_object_last_frame;
+      const bool present = i >= f0 && i <= f1;
+      renderer.SetPlaneVisible(object_index, present);
+      if (present) {
+        const double u = f1 > f0 ? static_cast<double>(i - f0) / (f1 - f0)
+                                 : 0.5;
+        const Eigen::Vector3d centre_in_cam(
+            (2.0 * u - 1.0) * 0.7 * half_width, 0.05,
+            options.moving_object_distance_m);
+        const Eigen::Vector3d centre = world_from_cam * centre_in_cam;
+        Plane plane;
+        PlaneFrame frame;
+        PlaceDisc(options.moving_object_radius_m, centre,
+                  world_from_cam.translation - centre, &plane, &frame);
+        renderer.SetPlanePose(object_index, plane, frame);
+      }
+    }
+    std::vector<SceneRenderer::Highlight> highlights;
+    if (options.specular_highlight && world.floor_plane >= 0) {
+      for (const Eigen::Vector3d& light : world.lights) {
+        SceneRenderer::Highlight h;
+        if (!SpecularPoint(light, world_from_cam.translation, 0.0,
+                           &h.centre)) {
+          continue;
+        }
+        h.plane_index = world.floor_plane;
+        h.radius_m = options.highlight_radius_m;
+        h.strength = options.highlight_strength;
+        highlights.push_back(h);
+      }
+    }
+    const cv::Mat radiance = renderer.Render(world_from_cam, highlights);
+    const cv::Mat image = ApplyCameraEffects(
+        radiance, truth[i].timestamp - truth[0].timestamp, options.effects,
+        options.seed, SimMixSeed(options.seed, 1000000 + i));
+    char name[32];
+    std::snprintf(name, sizeof(name), "rgb/%06d.png", i);
+    if (!cv::imwrite((root / name).string(), image)) {
+      throw OutputError((root / name).string() + ": cannot write image");
+    }
+    char line[96];
+    std::snprintf(line, sizeof(line), "%.6f %s\n", truth[i].timestamp, name);
+    rgb_list << line;
+    progress.Advance();
+  }
+  progress.Finish();
+  WriteFileAtomic(root / "rgb.txt", rgb_list.str());
+
+  if (options.write_structure) {
+    Map structure;
+    structure.camera = camera;
+    structure.planes = world.planes;
+    structure.trajectory = gt_cam;
+    fs::create_directories(root / "structure");
+    WriteMap(root / "structure", structure);
+  }
+  dir.Commit();
+  report.seconds = timer.ElapsedSeconds();
+  return report;
+}
+
+}  // namespace monomap
