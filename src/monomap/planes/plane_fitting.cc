@@ -1,0 +1,405 @@
+#include "monomap/planes/plane_fitting.h"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <opencv2/imgproc.hpp>
+#include <unordered_map>
+
+#include "monomap/geometry/polygon.h"
+#include "monomap/util/error.h"
+#include "monomap/util/progress.h"
+
+namespace monomap {
+
+void PlaneFittingOptions::Check() const {
+  CheckOption(ransac_iterations > 0, "planes.ransac_iterations", "must be > 0");
+  CheckOption(min_threshold_m > 0, "planes.min_threshold_m", "must be > 0");
+  CheckOption(relative_threshold >= 0, "planes.relative_threshold",
+              "must be >= 0");
+  CheckOption(max_threshold_m >= min_threshold_m, "planes.max_threshold_m",
+              "must be >= min_threshold_m");
+  CheckOption(refine_iterations >= 0, "planes.refine_iterations",
+              "must be >= 0");
+  CheckOption(min_inliers >= 3, "planes.min_inliers", "must be >= 3");
+  CheckOption(min_inlier_fraction >= 0 && min_inlier_fraction < 1,
+              "planes.min_inlier_fraction", "must be in [0, 1)");
+  CheckOption(std::isfinite(connectivity_radius_m),
+              "planes.connectivity_radius_m", "must be finite");
+  CheckOption(connectivity_factor > 0, "planes.connectivity_factor",
+              "must be > 0");
+  CheckOption(min_connectivity_radius_m > 0, "planes.min_connectivity_radius_m",
+              "must be > 0");
+  CheckOption(max_connectivity_radius_m >= min_connectivity_radius_m,
+              "planes.max_connectivity_radius_m",
+              "must be >= min_connectivity_radius_m");
+  CheckOption(max_planes > 0, "planes.max_planes", "must be > 0");
+  CheckOption(max_consecutive_failures >= 1, "planes.max_consecutive_failures",
+              "must be >= 1");
+  CheckOption(polygon_cell_factor > 0, "planes.polygon_cell_factor",
+              "must be > 0");
+}
+
+namespace {
+
+// Uniform hash grid over 2D points for fixed-radius neighbour queries.
+class Grid2d {
+ public:
+  Grid2d(const std::vector<Eigen::Vector2d>& points, double cell)
+      : points_(points), inv_cell_(1.0 / cell) {
+    for (size_t i = 0; i < points.size(); ++i) {
+      const auto [cx, cy] = CellOf(points[i]);
+      cells_[Key(cx, cy)].push_back(static_cast<int>(i));
+    }
+  }
+  // Calls fn(j) for every point j in the 3x3 cells around p.
+  template <typename Fn>
+  void ForNearby(const Eigen::Vector2d& p, Fn&& fn) const {
+    const auto [cx, cy] = CellOf(p);
+    for (int64_t dx = -1; dx <= 1; ++dx) {
+      for (int64_t dy = -1; dy <= 1; ++dy) {
+        const auto it = cells_.find(Key(cx + dx, cy + dy));
+        if (it == cells_.end()) continue;
+        for (int j : it->second) fn(j);
+      }
+    }
+  }
+
+ private:
+  std::pair<int64_t, int64_t> CellOf(const Eigen::Vector2d& p) const {
+    return {static_cast<int64_t>(std::floor(p.x() * inv_cell_)),
+            static_cast<int64_t>(std::floor(p.y() * inv_cell_))};
+  }
+  static int64_t Key(int64_t x, int64_t y) {
+    return (x << 32) ^ (y & 0xffffffffLL);
+  }
+  const std::vector<Eigen::Vector2d>& points_;
+  double inv_cell_;
+  std::unordered_map<int64_t, std::vector<int>> cells_;
+};
+
+// Median distance of each point to its nearest neighbour. A grid whose cell
+// is twice the mean spacing finds the neighbour of all but isolated points,
+// which the median ignores anyway.
+double MedianNearestNeighbourSpacing(const std::vector<Eigen::Vector2d>& st) {
+  Eigen::Vector2d lo = st[0], hi = st[0];
+  for (const auto& p : st) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  const Eigen::Vector2d ext = (hi - lo).cwiseMax(1e-9);
+  const double mean_spacing = std::sqrt(ext.x() * ext.y() / st.size());
+  const double cell = std::max(2.0 * mean_spacing, 1e-9);
+  Grid2d grid(st, cell);
+  std::vector<double> nn;
+  nn.reserve(st.size());
+  for (size_t i = 0; i < st.size(); ++i) {
+    double best = std::numeric_limits<double>::infinity();
+    grid.ForNearby(st[i], [&](int j) {
+      if (static_cast<size_t>(j) == i) return;
+      best = std::min(best, (st[j] - st[i]).squaredNorm());
+    });
+    if (std::isfinite(best)) nn.push_back(std::sqrt(best));
+  }
+  if (nn.empty()) return cell;
+  auto mid = nn.begin() + nn.size() / 2;
+  std::nth_element(nn.begin(), mid, nn.end());
+  return *mid;
+}
+
+int FindRoot(std::vector<int>& parent, int i) {
+  while (parent[i] != i) {
+    parent[i] = parent[parent[i]];
+    i = parent[i];
+  }
+  return i;
+}
+
+// Connected components of the points under "distance < radius". Returns the
+// components as index lists, largest first (ties: smallest first index).
+std::vector<std::vector<int>> ConnectedComponents(
+    const std::vector<Eigen::Vector2d>& st, double radius) {
+  const int n = static_cast<int>(st.size());
+  std::vector<int> parent(n);
+  std::iota(parent.begin(), parent.end(), 0);
+  Grid2d grid(st, radius);
+  const double r2 = radius * radius;
+  for (int i = 0; i < n; ++i) {
+    grid.ForNearby(st[i], [&](int j) {
+      if (j <= i || (st[j] - st[i]).squaredNorm() >= r2) return;
+      const int a = FindRoot(parent, i), b = FindRoot(parent, j);
+      if (a != b) parent[std::max(a, b)] = std::min(a, b);
+    });
+  }
+  std::unordered_map<int, int> slot;
+  std::vector<std::vector<int>> comps;
+  for (int i = 0; i < n; ++i) {
+    const int root = FindRoot(parent, i);
+    auto [it, fresh] = slot.emplace(root, static_cast<int>(comps.size()));
+    if (fresh) comps.emplace_back();
+    comps[it->second].push_back(i);
+  }
+  std::stable_sort(
+      comps.begin(), comps.end(),
+      [](const auto& a, const auto& b) { return a.size() > b.size(); });
+  return comps;
+}
+
+// Outline of the occupancy grid of the points (cell size `cell`), closed
+// morphologically so sampling gaps do not punch holes; falls back to the
+// convex hull when the grid is degenerate.
+Polygon2d OccupancyOutline(const std::vector<Eigen::Vector2d>& st,
+                           double cell) {
+  Eigen::Vector2d lo = st[0], hi = st[0];
+  for (const auto& p : st) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  // Centre the grid on the points so the cells overhang equally on both
+  // sides.
+  for (int a = 0; a < 2; ++a) {
+    const double extent = hi(a) - lo(a);
+    lo(a) -= 0.5 * ((std::floor(extent / cell) + 1) * cell - extent);
+  }
+  const int margin = 2;
+  const double cols_d = (hi.x() - lo.x()) / cell + 2 * margin + 1;
+  const double rows_d = (hi.y() - lo.y()) / cell + 2 * margin + 1;
+  if (cols_d * rows_d > 2.5e5) return ConvexHull(st);  // too fine: stay cheap
+  cv::Mat1b cells =
+      cv::Mat1b::zeros(static_cast<int>(rows_d), static_cast<int>(cols_d));
+  for (const auto& p : st) {
+    const int c = static_cast<int>((p.x() - lo.x()) / cell) + margin;
+    const int r = static_cast<int>((p.y() - lo.y()) / cell) + margin;
+    cells(r, c) = 255;
+  }
+  cv::morphologyEx(cells, cells, cv::MORPH_CLOSE,
+                   cv::getStructuringElement(cv::MORPH_RECT, {3, 3}));
+  // Contours pass through boundary pixel centres; upsampling the cells
+  // puts them 1/8 cell inside the occupied area instead of 1/2.
+  constexpr int kUp = 4;
+  cv::Mat1b mask;
+  cv::resize(cells, mask, {}, kUp, kUp, cv::INTER_NEAREST);
+  std::vector<std::vector<cv::Point>> contours;
+  cv::findContours(mask, contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_SIMPLE);
+  if (contours.empty()) return ConvexHull(st);
+  const auto largest = std::max_element(
+      contours.begin(), contours.end(), [](const auto& a, const auto& b) {
+        return std::abs(cv::contourArea(a)) < std::abs(cv::contourArea(b));
+      });
+  std::vector<cv::Point> simple;
+  cv::approxPolyDP(*largest, simple, 0.5 * kUp, true);
+  if (simple.size() < 3) return ConvexHull(st);
+  // The contour runs through the centres of the boundary pixels: move each
+  // vertex half a pixel outwards (miter offset) onto the pixel edges.
+  Polygon2d px;
+  for (const auto& q : simple) px.emplace_back(q.x + 0.5, q.y + 0.5);
+  const double orientation = PolygonArea(px) > 0 ? 1.0 : -1.0;
+  const size_t m = px.size();
+  Polygon2d poly;
+  for (size_t i = 0; i < m; ++i) {
+    const Eigen::Vector2d& prev = px[(i + m - 1) % m];
+    const Eigen::Vector2d& next = px[(i + 1) % m];
+    const Eigen::Vector2d d1 = (px[i] - prev).normalized();
+    const Eigen::Vector2d d2 = (next - px[i]).normalized();
+    const Eigen::Vector2d n1 = orientation * Eigen::Vector2d(d1.y(), -d1.x());
+    const Eigen::Vector2d n2 = orientation * Eigen::Vector2d(d2.y(), -d2.x());
+    const double denom = std::max(1.0 + n1.dot(n2), 0.25);  // cap spikes
+    const Eigen::Vector2d q = px[i] + 0.5 * (n1 + n2) / denom;
+    poly.emplace_back(lo.x() + (q.x() / kUp - margin) * cell,
+                      lo.y() + (q.y() / kUp - margin) * cell);
+  }
+  if (PolygonArea(poly) < 0) std::reverse(poly.begin(), poly.end());
+  return poly;
+}
+
+uint64_t MixSeed(uint64_t seed, uint64_t k) {
+  // splitmix64 step: decorrelates the seeds of successive RANSAC runs.
+  uint64_t z = seed + 0x9e3779b97f4a7c15ULL * (k + 1);
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  return z ^ (z >> 31);
+}
+
+}  // namespace
+
+PlaneFittingReport FitPlanes(
+    const PlaneFittingOptions& options, std::vector<Landmark>* landmarks,
+    std::vector<PlaneSegment>* segments,
+    const std::vector<Eigen::Vector3d>* camera_centers) {
+  options.Check();
+  Timer timer;
+  PlaneFittingReport report;
+  segments->clear();
+  std::vector<Landmark>& lms = *landmarks;
+  const int n = static_cast<int>(lms.size());
+  report.num_points = n;
+
+  // Per-landmark threshold; invalid points never enter the search.
+  std::vector<double> thresholds(n, options.min_threshold_m);
+  std::vector<int> remaining;
+  remaining.reserve(n);
+  for (int i = 0; i < n; ++i) {
+    lms[i].plane_id = -1;
+    if (!lms[i].x_in_world.allFinite()) continue;
+    const double depth = lms[i].mean_depth_m;
+    if (std::isfinite(depth) && depth > 0) {
+      thresholds[i] =
+          std::clamp(options.relative_threshold * depth,
+                     options.min_threshold_m, options.max_threshold_m);
+    }
+    remaining.push_back(i);
+  }
+  const size_t min_count = static_cast<size_t>(std::max<double>(
+      options.min_inliers, std::ceil(options.min_inlier_fraction * n)));
+
+  std::vector<Eigen::Vector3d> pts;
+  std::vector<double> inv_thr;
+  std::vector<char> taken(n, 0);  // on a segment or set aside
+  int failures = 0;
+  for (int attempt = 0;
+       static_cast<int>(segments->size()) < options.max_planes &&
+       remaining.size() >= min_count &&
+       failures < options.max_consecutive_failures;
+       ++attempt) {
+    pts.resize(remaining.size());
+    inv_thr.resize(remaining.size());
+    for (size_t k = 0; k < remaining.size(); ++k) {
+      pts[k] = lms[remaining[k]].x_in_world;
+      inv_thr[k] = 1.0 / thresholds[remaining[k]];
+    }
+    const PlaneEstimator estimator{&pts, &inv_thr};
+    RansacOptions ransac;
+    ransac.max_iterations = options.ransac_iterations;
+    ransac.min_iterations =
+        std::min(ransac.min_iterations, options.ransac_iterations);
+    ransac.inlier_threshold = 1.0;
+    ransac.confidence = 1.0;
+    ransac.seed = MixSeed(options.seed, attempt);
+    const auto best = Ransac(estimator, ransac);
+    report.iterations += best.iterations;
+    // The best plane is too small: the rest is noise.
+    if (!best.success || best.inliers.size() < min_count) break;
+
+    // Least squares on the inliers, re-selecting them each time.
+    Plane plane = best.model;
+    std::vector<size_t> inliers = best.inliers;
+    std::vector<Eigen::Vector3d> inlier_pts;
+    for (int it = 0; it < options.refine_iterations; ++it) {
+      inlier_pts.clear();
+      for (size_t k : inliers) inlier_pts.push_back(pts[k]);
+      const Plane refined = FitPlaneLeastSquares(inlier_pts);
+      std::vector<size_t> reselected;
+      for (size_t k = 0; k < pts.size(); ++k) {
+        if (estimator.Residual(refined, k) <= 1.0) reselected.push_back(k);
+      }
+      if (reselected.size() < 3) break;
+      plane = refined;
+      if (reselected == inliers) break;
+      inliers = std::move(reselected);
+    }
+
+    // Split the inliers into connected regions of the plane.
+    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+    for (size_t k : inliers) centroid += pts[k];
+    centroid /= static_cast<double>(inliers.size());
+    const PlaneFrame split_frame =
+        MakePlaneFrame(plane, centroid, plane.normal.unitOrthogonal());
+    std::vector<Eigen::Vector2d> st(inliers.size());
+    for (size_t k = 0; k < inliers.size(); ++k) {
+      st[k] = split_frame.ToPlane(pts[inliers[k]]);
+    }
+    double radius = options.connectivity_radius_m;
+    if (radius <= 0) {
+      radius = std::clamp(
+          options.connectivity_factor * MedianNearestNeighbourSpacing(st),
+          options.min_connectivity_radius_m, options.max_connectivity_radius_m);
+    }
+    const auto components = ConnectedComponents(st, radius);
+
+    bool accepted = false;
+    for (const auto& comp : components) {
+      if (comp.size() < min_count ||
+          static_cast<int>(segments->size()) >= options.max_planes) {
+        ++report.discarded_regions;
+        continue;
+      }
+      accepted = true;
+      PlaneSegment seg;
+      seg.id = static_cast<int>(segments->size());
+      std::vector<Eigen::Vector3d> cpts;
+      cpts.reserve(comp.size());
+      for (int c : comp) cpts.push_back(pts[inliers[c]]);
+      seg.plane = FitPlaneLeastSquares(cpts);
+      // Orientation: towards the cameras, else towards the world origin.
+      bool flip = seg.plane.offset < 0;
+      if (camera_centers != nullptr && !camera_centers->empty()) {
+        int votes = 0;
+        double sum = 0.0;
+        for (const auto& c : *camera_centers) {
+          const double d = seg.plane.SignedDistance(c);
+          votes += d > 0 ? 1 : (d < 0 ? -1 : 0);
+          sum += d;
+        }
+        flip = votes < 0 || (votes == 0 && sum < 0);
+      }
+      if (flip) {
+        seg.plane.normal = -seg.plane.normal;
+        seg.plane.offset = -seg.plane.offset;
+      }
+      // Frame: centroid origin, u along the principal in-plane direction.
+      Eigen::Vector3d c = Eigen::Vector3d::Zero();
+      for (const auto& p : cpts) c += p;
+      c /= static_cast<double>(cpts.size());
+      Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+      double sq = 0.0;
+      for (const auto& p : cpts) {
+        const double dist = seg.plane.SignedDistance(p);
+        sq += dist * dist;
+        const Eigen::Vector3d d = (p - c) - dist * seg.plane.normal;
+        scatter += d * d.transpose();
+      }
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(scatter);
+      Eigen::Vector3d u = eig.eigenvectors().col(2);
+      Eigen::Index big;
+      u.cwiseAbs().maxCoeff(&big);
+      if (u(big) < 0) u = -u;  // canonical sign: deterministic frames
+      seg.frame = MakePlaneFrame(seg.plane, c, u);
+      seg.rms_distance_m = std::sqrt(sq / cpts.size());
+      seg.inlier_ids.reserve(comp.size());
+      seg.inlier_st.reserve(comp.size());
+      for (int k : comp) {
+        const int lm = remaining[inliers[k]];
+        lms[lm].plane_id = seg.id;
+        taken[lm] = 1;
+        seg.inlier_ids.push_back(lms[lm].id);
+        seg.inlier_st.push_back(seg.frame.ToPlane(lms[lm].x_in_world));
+      }
+      seg.polygon = options.concave_polygon
+                        ? OccupancyOutline(seg.inlier_st,
+                                           options.polygon_cell_factor * radius)
+                        : ConvexHull(seg.inlier_st);
+      report.inliers_per_plane.push_back(static_cast<int>(comp.size()));
+      segments->push_back(std::move(seg));
+    }
+    if (accepted) {
+      failures = 0;
+    } else {
+      // No coherent region: a plane through clutter. Set its points aside
+      // so the next hypothesis differs.
+      ++failures;
+      ++report.rejected_hypotheses;
+      for (size_t k : inliers) taken[remaining[k]] = 1;
+    }
+    std::erase_if(remaining, [&](int i) { return taken[i] != 0; });
+  }
+
+  report.num_planes = static_cast<int>(segments->size());
+  report.num_outliers = 0;
+  for (const auto& lm : lms) report.num_outliers += lm.plane_id < 0 ? 1 : 0;
+  report.seconds = timer.ElapsedSeconds();
+  return report;
+}
+
+}  // namespace monomap

@@ -1,0 +1,368 @@
+#include "monomap/planes/plane_fitting.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <random>
+
+#include "monomap/util/error.h"
+
+namespace monomap {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr int kOutlier = -1;
+constexpr int kBlob = -2;
+
+// One true planar region: a rectangle [0, w] x [0, h] of a frame.
+struct TrueRegion {
+  Plane plane;
+  PlaneFrame frame;
+  double w, h;
+  int count;
+};
+
+struct Scene {
+  std::vector<TrueRegion> regions;
+  std::vector<Landmark> landmarks;
+  std::vector<int> label;  // region index, kOutlier or kBlob
+};
+
+PlaneFrame FrameOf(const Eigen::Vector3d& origin, const Eigen::Vector3d& u,
+                   const Eigen::Vector3d& v) {
+  PlaneFrame f;
+  f.origin = origin;
+  f.u_axis = u.normalized();
+  f.v_axis = (v - v.dot(f.u_axis) * f.u_axis).normalized();
+  return f;
+}
+
+// A floor and two walls meeting at a corner (different sizes), two
+// coplanar but disconnected patches on a tilted plane, a mug-like cylinder
+// of points standing above the floor, and 20% outliers in the volume.
+Scene MakeScene(uint64_t seed) {
+  Scene scene;
+  auto add_region = [&](const PlaneFrame& f, double w, double h, int count) {
+    TrueRegion r;
+    r.frame = f;
+    r.plane.normal = f.Normal();
+    r.plane.offset = -r.plane.normal.dot(f.origin);
+    r.w = w;
+    r.h = h;
+    r.count = count;
+    scene.regions.push_back(r);
+  };
+  const Eigen::Vector3d ex = Eigen::Vector3d::UnitX();
+  const Eigen::Vector3d ey = Eigen::Vector3d::UnitY();
+  const Eigen::Vector3d ez = Eigen::Vector3d::UnitZ();
+  add_region(FrameOf({0, 0, 0}, ex, ey), 3.0, 2.5, 2500);  // floor z = 0
+  add_region(FrameOf({0, 0, 0}, ey, ez), 2.5, 2.0, 1500);  // wall x = 0
+  add_region(FrameOf({0, 0, 0}, ex, ez), 2.0, 1.5, 1000);  // wall y = 0
+  // Tilted plane near y = 2.6 with two 0.5 m patches 0.8 m apart.
+  const Eigen::Vector3d u = Eigen::Vector3d(1, 0.1, 0).normalized();
+  const Eigen::Vector3d v = Eigen::Vector3d(0, 0.2, 1).normalized();
+  add_region(FrameOf({0.5, 2.6, 0.8}, u, v), 0.5, 0.5, 400);
+  add_region(FrameOf(Eigen::Vector3d(0.5, 2.6, 0.8) + 1.3 * u, u, v), 0.5, 0.5,
+             400);
+
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> uni(0.0, 1.0);
+  std::normal_distribution<double> noise(0.0, 0.001);
+  auto push = [&](const Eigen::Vector3d& x, int label) {
+    Landmark lm;
+    lm.id = 1000 + static_cast<FeatureId>(scene.landmarks.size());
+    lm.x_in_world = x;
+    lm.mean_depth_m = 0.3 + 0.3 * uni(rng);  // thresholds 3..6 mm
+    scene.landmarks.push_back(lm);
+    scene.label.push_back(label);
+  };
+  auto jitter = [&]() {
+    return Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
+  };
+  for (size_t r = 0; r < scene.regions.size(); ++r) {
+    const auto& reg = scene.regions[r];
+    for (int i = 0; i < reg.count; ++i) {
+      const Eigen::Vector2d st(reg.w * uni(rng), reg.h * uni(rng));
+      push(reg.frame.ToWorld(st) + jitter(), static_cast<int>(r));
+    }
+  }
+  // Mug: radius 4 cm, 10 cm tall, 2 cm above the floor.
+  for (int i = 0; i < 200; ++i) {
+    const double a = 2 * kPi * uni(rng);
+    push(Eigen::Vector3d(2.0 + 0.04 * std::cos(a), 1.5 + 0.04 * std::sin(a),
+                         0.02 + 0.10 * uni(rng)) +
+             jitter(),
+         kBlob);
+  }
+  // 20% of all points are outliers in the box around the scene.
+  const int num_outliers = static_cast<int>(scene.landmarks.size()) / 4;
+  for (int i = 0; i < num_outliers; ++i) {
+    push(Eigen::Vector3d(-0.2 + 3.4 * uni(rng), -0.2 + 3.2 * uni(rng),
+                         -0.2 + 2.4 * uni(rng)),
+         kOutlier);
+  }
+  return scene;
+}
+
+TEST(FitPlanes, RecoversPlanesSplitsPatchesRejectsClutter) {
+  Scene scene = MakeScene(3);
+  const std::vector<Eigen::Vector3d> cameras = {{2.5, 2.0, 1.2},
+                                                {2.0, 1.8, 1.0}};
+  std::vector<PlaneSegment> segments;
+  PlaneFittingOptions options;
+  options.concave_polygon = false;  // convex hulls; outlines tested below
+  const auto report = FitPlanes(options, &scene.landmarks, &segments, &cameras);
+  ASSERT_EQ(report.num_planes, 5);
+  ASSERT_EQ(segments.size(), 5u);
+  EXPECT_EQ(report.num_points, static_cast<int>(scene.landmarks.size()));
+  EXPECT_EQ(report.inliers_per_plane.size(), 5u);
+  EXPECT_GE(report.iterations, 5 * options.ransac_iterations);
+
+  // Match segments to true regions by majority label.
+  std::vector<int> seg_of_region(scene.regions.size(), -1);
+  for (const auto& seg : segments) {
+    std::map<int, int> votes;
+    for (size_t i = 0; i < scene.landmarks.size(); ++i) {
+      if (scene.landmarks[i].plane_id == seg.id) ++votes[scene.label[i]];
+    }
+    int best = kOutlier, best_votes = 0;
+    for (auto [label, v] : votes) {
+      if (v > best_votes) best = label, best_votes = v;
+    }
+    ASSERT_GE(best, 0) << "segment " << seg.id << " is clutter";
+    EXPECT_EQ(seg_of_region[best], -1) << "region " << best << " twice";
+    seg_of_region[best] = seg.id;
+  }
+
+  int num_outliers = 0;
+  for (const auto& lm : scene.landmarks) num_outliers += lm.plane_id < 0;
+  EXPECT_EQ(report.num_outliers, num_outliers);
+
+  for (size_t r = 0; r < scene.regions.size(); ++r) {
+    SCOPED_TRACE("region " + std::to_string(r));
+    ASSERT_GE(seg_of_region[r], 0);
+    const PlaneSegment& seg = segments[seg_of_region[r]];
+    const Plane& truth = scene.regions[r].plane;
+    const double angle_deg = PlaneAngle(seg.plane, truth) * 180.0 / kPi;
+    EXPECT_LT(angle_deg, 0.5);
+    const double sign = seg.plane.normal.dot(truth.normal) > 0 ? 1.0 : -1.0;
+    EXPECT_LT(std::abs(sign * seg.plane.offset - truth.offset), 0.002);
+    // Recall and precision of the inliers.
+    int tp = 0, fp = 0, fn = 0;
+    for (size_t i = 0; i < scene.landmarks.size(); ++i) {
+      const bool on = scene.landmarks[i].plane_id == seg.id;
+      const bool truly = scene.label[i] == static_cast<int>(r);
+      tp += on && truly;
+      fp += on && !truly;
+      fn += !on && truly;
+    }
+    std::printf("region %zu: recall %.4f precision %.4f offset err %.3f mm\n",
+                r, tp / double(tp + fn), tp / double(tp + fp),
+                1000 * std::abs(sign * seg.plane.offset - truth.offset));
+    EXPECT_GT(tp / double(tp + fn), 0.95);
+    EXPECT_GT(tp / double(tp + fp), 0.95);
+    EXPECT_EQ(seg.inlier_ids.size(), static_cast<size_t>(tp + fp));
+    EXPECT_EQ(seg.inlier_st.size(), seg.inlier_ids.size());
+    EXPECT_LT(seg.rms_distance_m, 0.002);
+    EXPECT_GT(seg.rms_distance_m, 0.0005);
+    // Normal faces the cameras.
+    for (const auto& c : cameras) EXPECT_GT(seg.plane.SignedDistance(c), 0);
+    // Frame: right-handed on the plane, origin near the centroid, u along
+    // the longer side of the rectangle.
+    EXPECT_NEAR(seg.frame.Normal().dot(seg.plane.normal), 1.0, 1e-9);
+    EXPECT_NEAR(seg.plane.SignedDistance(seg.frame.origin), 0.0, 1e-9);
+    const auto& reg = scene.regions[r];
+    const Eigen::Vector3d centre =
+        reg.frame.ToWorld(Eigen::Vector2d(reg.w / 2, reg.h / 2));
+    EXPECT_LT((seg.frame.origin - centre).norm(), 0.05);
+    if (reg.w > 1.1 * reg.h) {
+      EXPECT_GT(std::abs(seg.frame.u_axis.dot(reg.frame.u_axis)), 0.99);
+    }
+    // inlier_st are the plane coordinates of the inliers.
+    for (size_t k = 0; k < seg.inlier_ids.size(); k += 97) {
+      const Landmark& lm = scene.landmarks[seg.inlier_ids[k] - 1000];
+      EXPECT_LT((seg.frame.ToWorld(seg.inlier_st[k]) -
+                 seg.plane.Project(lm.x_in_world))
+                    .norm(),
+                1e-9);
+    }
+    // The polygon covers the rectangle (convex hull of its samples).
+    const double area = PolygonArea(seg.polygon);
+    std::printf("region %zu: area %.3f of %.3f, angle %.4f deg, rms %.4f mm\n",
+                r, area, reg.w * reg.h, angle_deg, 1000 * seg.rms_distance_m);
+    EXPECT_GT(area, 0.93 * reg.w * reg.h);
+    EXPECT_LT(area, 1.05 * reg.w * reg.h) << "true " << reg.w * reg.h;
+  }
+
+  // The mug is clutter, not a plane.
+  int blob = 0, blob_out = 0;
+  for (size_t i = 0; i < scene.landmarks.size(); ++i) {
+    if (scene.label[i] != kBlob) continue;
+    ++blob;
+    blob_out += scene.landmarks[i].plane_id < 0;
+  }
+  std::printf("blob: %d of %d are outliers\n", blob_out, blob);
+  EXPECT_GE(blob_out, 0.9 * blob);
+}
+
+TEST(FitPlanes, PlaneThroughSeveralSmallObjectsIsRejected) {
+  // A floor, and the tops of 8 small boxes at one height: together they
+  // hold 160 coplanar points (> min_inliers), but each top holds only 20,
+  // so no coherent segment exists at that height.
+  std::mt19937_64 rng(4);
+  std::uniform_real_distribution<double> uni(0.0, 1.0);
+  std::normal_distribution<double> noise(0.0, 0.001);
+  std::vector<Landmark> lms;
+  std::vector<bool> on_floor;
+  auto push = [&](const Eigen::Vector3d& x, bool floor) {
+    Landmark lm;
+    lm.id = static_cast<FeatureId>(lms.size());
+    lm.x_in_world = x + Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
+    lm.mean_depth_m = 0.5;
+    lms.push_back(lm);
+    on_floor.push_back(floor);
+  };
+  for (int i = 0; i < 2000; ++i) push({3 * uni(rng), 3 * uni(rng), 0}, true);
+  for (int b = 0; b < 8; ++b) {
+    const double x0 = 0.3 + 0.7 * (b % 4), y0 = 0.5 + 1.5 * (b / 4);
+    for (int i = 0; i < 20; ++i) {
+      push({x0 + 0.1 * uni(rng), y0 + 0.1 * uni(rng), 0.4}, false);
+    }
+  }
+  std::vector<PlaneSegment> segments;
+  const auto report = FitPlanes(PlaneFittingOptions(), &lms, &segments);
+  ASSERT_EQ(segments.size(), 1u);
+  EXPECT_LT(segments[0].plane.normal.cross(Eigen::Vector3d::UnitZ()).norm(),
+            1e-3);
+  EXPECT_GE(report.rejected_hypotheses, 1);
+  // Every box-top point is an outlier; the floor keeps (nearly) all of its
+  // own (an isolated corner sample may fall outside the connected region).
+  int floor_in = 0, floor_total = 0;
+  for (size_t i = 0; i < lms.size(); ++i) {
+    if (on_floor[i]) {
+      ++floor_total;
+      floor_in += lms[i].plane_id == 0;
+    } else {
+      EXPECT_EQ(lms[i].plane_id, -1);
+    }
+  }
+  EXPECT_GE(floor_in, 0.995 * floor_total);
+}
+
+TEST(FitPlanes, ConcaveOutlineOfRectanglesKeepsTheirArea) {
+  Scene scene = MakeScene(3);
+  std::vector<PlaneSegment> segments;
+  PlaneFittingOptions options;  // concave_polygon by default
+  FitPlanes(options, &scene.landmarks, &segments);
+  ASSERT_EQ(segments.size(), 5u);
+  for (const auto& seg : segments) {
+    // Region of the segment: the label of its first inlier.
+    const int r = scene.label[seg.inlier_ids[0] - 1000];
+    ASSERT_GE(r, 0);
+    const double truth = scene.regions[r].w * scene.regions[r].h;
+    const double area = PolygonArea(seg.polygon);
+    std::printf("concave region %d: area %.3f of %.3f, %zu vertices\n", r, area,
+                truth, seg.polygon.size());
+    EXPECT_GT(area, 0.93 * truth);
+    EXPECT_LT(area, 1.06 * truth);
+    // Nearly all inliers inside the outline.
+    int inside = 0;
+    for (const auto& st : seg.inlier_st) {
+      inside += PointInPolygon(seg.polygon, st);
+    }
+    EXPECT_GT(inside, 0.99 * seg.inlier_st.size());
+  }
+}
+
+TEST(FitPlanes, DeterministicGivenSeed) {
+  Scene a = MakeScene(11), b = MakeScene(11);
+  std::vector<PlaneSegment> sa, sb;
+  PlaneFittingOptions options;
+  options.seed = 5;
+  FitPlanes(options, &a.landmarks, &sa);
+  FitPlanes(options, &b.landmarks, &sb);
+  ASSERT_EQ(sa.size(), sb.size());
+  ASSERT_EQ(sa.size(), 5u);
+  for (size_t i = 0; i < sa.size(); ++i) {
+    EXPECT_EQ(sa[i].inlier_ids, sb[i].inlier_ids);
+    EXPECT_EQ(sa[i].plane.normal, sb[i].plane.normal);
+    EXPECT_EQ(sa[i].plane.offset, sb[i].plane.offset);
+    EXPECT_EQ(sa[i].frame.u_axis, sb[i].frame.u_axis);
+    EXPECT_EQ(sa[i].polygon, sb[i].polygon);
+    // Without cameras, normals face the world origin.
+    EXPECT_GE(sa[i].plane.offset, 0.0);
+  }
+  for (size_t i = 0; i < a.landmarks.size(); ++i) {
+    EXPECT_EQ(a.landmarks[i].plane_id, b.landmarks[i].plane_id);
+  }
+}
+
+TEST(FitPlanes, ConcaveOutlineFollowsAnLShape) {
+  // An L-shaped floor: 2 x 2 m minus the 1 x 1 m upper-right quarter.
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> uni(0.0, 2.0);
+  std::vector<Landmark> lms;
+  while (lms.size() < 3000) {
+    const Eigen::Vector2d p(uni(rng), uni(rng));
+    if (p.x() > 1.0 && p.y() > 1.0) continue;
+    Landmark lm;
+    lm.id = static_cast<FeatureId>(lms.size());
+    lm.x_in_world = Eigen::Vector3d(p.x(), p.y(), 0.0);
+    lm.mean_depth_m = 1.0;
+    lms.push_back(lm);
+  }
+  std::vector<PlaneSegment> segments;
+  FitPlanes(PlaneFittingOptions(), &lms, &segments);
+  ASSERT_EQ(segments.size(), 1u);
+  const auto& seg = segments[0];
+  const double area = PolygonArea(seg.polygon);
+  EXPECT_GT(area, 2.7);  // true area 3; convex hull would be ~3.5
+  EXPECT_LT(area, 3.2);
+  // The missing quarter is outside the outline.
+  const Eigen::Vector2d notch =
+      seg.frame.ToPlane(Eigen::Vector3d(1.6, 1.6, 0.0));
+  EXPECT_FALSE(PointInPolygon(seg.polygon, notch));
+  const Eigen::Vector2d inside =
+      seg.frame.ToPlane(Eigen::Vector3d(0.5, 1.5, 0.0));
+  EXPECT_TRUE(PointInPolygon(seg.polygon, inside));
+}
+
+TEST(FitPlanes, NoiseOnlyGivesNoPlanes) {
+  std::mt19937_64 rng(2);
+  std::uniform_real_distribution<double> uni(0.0, 2.0);
+  std::vector<Landmark> lms(1500);
+  for (auto& lm : lms) {
+    lm.x_in_world = Eigen::Vector3d(uni(rng), uni(rng), uni(rng));
+    lm.mean_depth_m = 0.5;
+    lm.plane_id = 7;
+  }
+  std::vector<PlaneSegment> segments(2);
+  const auto report = FitPlanes(PlaneFittingOptions(), &lms, &segments);
+  EXPECT_EQ(report.num_planes, 0);
+  EXPECT_TRUE(segments.empty());
+  EXPECT_EQ(report.num_outliers, 1500);
+  for (const auto& lm : lms) EXPECT_EQ(lm.plane_id, -1);
+}
+
+TEST(FitPlanes, CheckRejectsBadOptions) {
+  PlaneFittingOptions options;
+  EXPECT_NO_THROW(options.Check());
+  options.ransac_iterations = 0;
+  EXPECT_THROW(options.Check(), OptionsError);
+  options = PlaneFittingOptions();
+  options.min_threshold_m = -0.001;
+  EXPECT_THROW(options.Check(), OptionsError);
+  options = PlaneFittingOptions();
+  options.max_threshold_m = 0.001;  // below min_threshold_m
+  EXPECT_THROW(options.Check(), OptionsError);
+  options = PlaneFittingOptions();
+  options.min_inlier_fraction = 1.5;
+  std::vector<Landmark> lms;
+  std::vector<PlaneSegment> segments;
+  EXPECT_THROW(FitPlanes(options, &lms, &segments), OptionsError);
+}
+
+}  // namespace
+}  // namespace monomap
