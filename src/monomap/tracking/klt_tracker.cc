@@ -1,0 +1,369 @@
+#include "monomap/tracking/klt_tracker.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <utility>
+
+#include <opencv2/imgproc.hpp>
+#include <opencv2/video/tracking.hpp>
+#include <tbb/concurrent_queue.h>
+#include <tbb/info.h>
+#include <tbb/parallel_pipeline.h>
+
+#include "monomap/util/error.h"
+#include "monomap/util/progress.h"
+
+namespace monomap {
+
+void KltTrackerOptions::Check() const {
+  CheckOption(target_features >= 1, "target_features", "must be >= 1");
+  CheckOption(quality_level > 0.0 && quality_level < 1.0, "quality_level",
+              "must be in (0, 1)");
+  CheckOption(min_distance_px >= 0.0, "min_distance_px", "must be >= 0");
+  CheckOption(detection_block_size >= 3, "detection_block_size",
+              "must be >= 3");
+  CheckOption(window_size >= 3 && window_size % 2 == 1, "window_size",
+              "must be odd and >= 3");
+  CheckOption(pyramid_levels >= 0 && pyramid_levels <= 10, "pyramid_levels",
+              "must be in [0, 10]");
+  CheckOption(lk_max_iterations >= 1, "lk_max_iterations", "must be >= 1");
+  CheckOption(lk_epsilon > 0.0, "lk_epsilon", "must be > 0");
+  CheckOption(lk_min_eigen_threshold >= 0.0, "lk_min_eigen_threshold",
+              "must be >= 0");
+  CheckOption(forward_backward_threshold_px > 0.0,
+              "forward_backward_threshold_px", "must be > 0");
+  CheckOption(border_margin_px >= 0.0, "border_margin_px", "must be >= 0");
+  CheckOption(grid_cols >= 1 && grid_rows >= 1, "grid_cols/grid_rows",
+              "must be >= 1");
+}
+
+KltTracker::KltTracker(const KltTrackerOptions& options) : options_(options) {
+  options_.Check();
+}
+
+std::vector<cv::Mat> KltTracker::BuildPyramid(
+    const cv::Mat& grey, const KltTrackerOptions& options) {
+  std::vector<cv::Mat> pyramid;
+  BuildPyramid(grey, options, &pyramid);
+  return pyramid;
+}
+
+void KltTracker::BuildPyramid(const cv::Mat& grey,
+                              const KltTrackerOptions& options,
+                              std::vector<cv::Mat>* pyramid) {
+  // With derivatives: the image is the "previous" one of the next frame's
+  // forward track and of this frame's backward track, so its gradients are
+  // needed twice; computing them here once saves LK doing it twice.
+  // Existing buffers of the right size are reused.
+  cv::buildOpticalFlowPyramid(
+      grey, *pyramid, cv::Size(options.window_size, options.window_size),
+      options.pyramid_levels, /*withDerivatives=*/true);
+}
+
+void KltTracker::Track(int frame_index, const cv::Mat& grey) {
+  std::vector<cv::Mat> pyramid = std::move(spare_pyramid_);
+  spare_pyramid_.clear();
+  if (!grey.empty()) BuildPyramid(grey, options_, &pyramid);
+  Track(frame_index, grey, std::move(pyramid));
+}
+
+void KltTracker::Track(int frame_index, const cv::Mat& grey,
+                       std::vector<cv::Mat> pyramid) {
+  const std::string where = "frame " + std::to_string(frame_index);
+  if (grey.empty() || grey.type() != CV_8UC1) {
+    throw InputError(where + ": tracking needs a non-empty 8-bit grey image");
+  }
+  if (last_frame_ >= 0 && frame_index <= last_frame_) {
+    throw InputError(where + ": frame indices must increase (previous " +
+                     std::to_string(last_frame_) + ")");
+  }
+  if (last_frame_ >= 0 && grey.size() != size_) {
+    throw InputError(where + ": image size " + std::to_string(grey.cols) +
+                     "x" + std::to_string(grey.rows) +
+                     " differs from the first frame's");
+  }
+  if (pyramid.empty()) throw InputError(where + ": empty image pyramid");
+  size_ = grey.size();
+
+  KltFrameStats stats;
+  stats.frame = frame_index;
+
+  if (last_frame_ >= 0 && !active_.empty()) {
+    const cv::Size window(options_.window_size, options_.window_size);
+    const cv::TermCriteria criteria(
+        cv::TermCriteria::COUNT | cv::TermCriteria::EPS,
+        options_.lk_max_iterations, options_.lk_epsilon);
+    std::vector<cv::Point2f> prev_pts(active_.size());
+    for (size_t i = 0; i < active_.size(); ++i) prev_pts[i] = active_[i].px;
+
+    std::vector<cv::Point2f> next_pts;
+    std::vector<uchar> status;
+    std::vector<float> error;
+    cv::calcOpticalFlowPyrLK(prev_pyramid_, pyramid, prev_pts, next_pts,
+                             status, error, window, options_.pyramid_levels,
+                             criteria, 0, options_.lk_min_eigen_threshold);
+
+    // Backward only for the features that survived the forward track.
+    std::vector<size_t> forward_ok;
+    std::vector<cv::Point2f> fwd_pts;
+    for (size_t i = 0; i < active_.size(); ++i) {
+      if (!status[i]) {
+        ++stats.lost_lk;
+      } else if (options_.max_lk_error > 0.0 &&
+                 error[i] > options_.max_lk_error) {
+        ++stats.lost_error;
+      } else {
+        forward_ok.push_back(i);
+        fwd_pts.push_back(next_pts[i]);
+      }
+    }
+    std::vector<cv::Point2f> back_pts;
+    std::vector<uchar> back_status;
+    std::vector<float> back_error;
+    if (!fwd_pts.empty()) {
+      // No initial guess at the original position: starting there would
+      // pull the backward track home even from content that changed.
+      cv::calcOpticalFlowPyrLK(pyramid, prev_pyramid_, fwd_pts, back_pts,
+                               back_status, back_error, window,
+                               options_.pyramid_levels, criteria, 0,
+                               options_.lk_min_eigen_threshold);
+    }
+
+    const double margin = options_.border_margin_px;
+    const double max_x = size_.width - 1 - margin;
+    const double max_y = size_.height - 1 - margin;
+    const double fb2 = options_.forward_backward_threshold_px *
+                       options_.forward_backward_threshold_px;
+    std::vector<Active> kept;
+    kept.reserve(active_.size());
+    for (size_t k = 0; k < forward_ok.size(); ++k) {
+      const Active& a = active_[forward_ok[k]];
+      const cv::Point2f p = fwd_pts[k];
+      if (!back_status[k]) {
+        ++stats.lost_lk;
+        continue;
+      }
+      const cv::Point2f d = back_pts[k] - a.px;
+      if (static_cast<double>(d.dot(d)) > fb2 || !std::isfinite(p.x) ||
+          !std::isfinite(p.y)) {
+        ++stats.lost_forward_backward;
+        continue;
+      }
+      if (p.x < margin || p.y < margin || p.x > max_x || p.y > max_y) {
+        ++stats.lost_border;
+        continue;
+      }
+      kept.push_back({a.id, p});
+      tracks_[static_cast<size_t>(a.id)].observations.push_back(
+          {frame_index, Eigen::Vector2d(p.x, p.y)});
+    }
+    active_ = std::move(kept);
+    stats.tracked = static_cast<int>(active_.size());
+  }
+
+  Detect(frame_index, grey, &stats);
+  stats.total = static_cast<int>(active_.size());
+
+  spare_pyramid_ = std::move(prev_pyramid_);
+  prev_pyramid_ = std::move(pyramid);
+  last_frame_ = frame_index;
+  last_stats_ = stats;
+  total_stats_.frame += 1;
+  total_stats_.tracked += stats.tracked;
+  total_stats_.lost_lk += stats.lost_lk;
+  total_stats_.lost_error += stats.lost_error;
+  total_stats_.lost_forward_backward += stats.lost_forward_backward;
+  total_stats_.lost_border += stats.lost_border;
+  total_stats_.detected += stats.detected;
+  total_stats_.total += stats.total;
+}
+
+void KltTracker::Detect(int frame_index, const cv::Mat& grey,
+                        KltFrameStats* stats) {
+  const int cols = options_.grid_cols;
+  const int rows = options_.grid_rows;
+  const int num_cells = cols * rows;
+  const int quota = std::max(1, (options_.target_features + num_cells - 1) /
+                                    num_cells);
+  auto cell_of = [&](const cv::Point2f& p) {
+    const int cx = std::clamp(static_cast<int>(p.x * cols / size_.width), 0,
+                              cols - 1);
+    const int cy = std::clamp(static_cast<int>(p.y * rows / size_.height), 0,
+                              rows - 1);
+    return cy * cols + cx;
+  };
+  std::vector<int> count(num_cells, 0);
+  for (const Active& a : active_) ++count[cell_of(a.px)];
+  int total = static_cast<int>(active_.size());
+  // Detection only tops up to the target: features are lost continuously
+  // (motion, occlusion), and each top-up serves the short cells first, so
+  // the spread recovers without ever exceeding target_features.
+  if (total >= options_.target_features) return;
+
+  // Search only inside the margin and away from existing features (so new
+  // ones do not duplicate them).
+  const int m = static_cast<int>(std::ceil(options_.border_margin_px));
+  const cv::Rect inner(m, m, size_.width - 2 * m, size_.height - 2 * m);
+  if (inner.width <= 0 || inner.height <= 0) return;
+  mask_.create(size_, CV_8UC1);  // reused: no page faults every frame
+  mask_.setTo(0);
+  mask_(inner).setTo(255);
+  const int radius = static_cast<int>(std::ceil(options_.min_distance_px));
+  if (radius > 0) {
+    for (const Active& a : active_) {
+      cv::circle(mask_, cv::Point(cvRound(a.px.x), cvRound(a.px.y)), radius,
+                 cv::Scalar(0), cv::FILLED);
+    }
+  }
+
+  // Candidates come sorted by corner strength and mutually spaced by
+  // min_distance_px. maxCorners = 0: all of them, since the grid below
+  // decides how many each area may take.
+  std::vector<cv::Point2f> corners;
+  cv::goodFeaturesToTrack(grey, corners, 0, options_.quality_level,
+                          options_.min_distance_px, mask_,
+                          options_.detection_block_size,
+                          /*useHarrisDetector=*/false);
+
+  std::vector<bool> taken(corners.size(), false);
+  auto start = [&](size_t k) {
+    taken[k] = true;
+    const FeatureId id = next_id_++;
+    active_.push_back({id, corners[k]});
+    monomap::Track track;
+    track.id = id;
+    track.observations.push_back(
+        {frame_index, Eigen::Vector2d(corners[k].x, corners[k].y)});
+    tracks_.push_back(std::move(track));
+    ++count[cell_of(corners[k])];
+    ++total;
+    ++stats->detected;
+  };
+  // First fill the cells short of their share (spread over the image) ...
+  for (size_t k = 0; k < corners.size() && total < options_.target_features;
+       ++k) {
+    if (count[cell_of(corners[k])] < quota) start(k);
+  }
+  // ... then, if textureless cells left the total short, take the
+  // strongest remaining corners anywhere.
+  for (size_t k = 0; k < corners.size() && total < options_.target_features;
+       ++k) {
+    if (!taken[k]) start(k);
+  }
+}
+
+std::vector<KltFeature> KltTracker::Features() const {
+  std::vector<KltFeature> features;
+  features.reserve(active_.size());
+  for (const Active& a : active_) {
+    features.push_back({a.id, Eigen::Vector2d(a.px.x, a.px.y)});
+  }
+  return features;
+}
+
+std::vector<Track> KltTracker::FinishedTracks(int min_length) const {
+  std::vector<monomap::Track> result;
+  for (const monomap::Track& t : tracks_) {
+    if (static_cast<int>(t.observations.size()) >= min_length) {
+      result.push_back(t);
+    }
+  }
+  return result;  // tracks_ is indexed by id, hence sorted
+}
+
+TrackingReport TrackFeatures(const std::function<cv::Mat(int)>& load_grey,
+                             int num_frames, const KltTrackerOptions& options,
+                             std::vector<Track>* tracks) {
+  options.Check();
+  if (num_frames < 1) {
+    throw StageError("TrackFeatures: no frames to track");
+  }
+  Timer timer;
+  KltTracker tracker(options);
+
+  struct Item {
+    int frame = 0;
+    cv::Mat grey;
+    std::vector<cv::Mat> pyramid;
+  };
+  // Decoding and pyramid building (parallel) overlap with the tracking
+  // (serial, in frame order). A few tokens per thread keep the tracker fed
+  // without holding many decoded images.
+  const size_t max_tokens =
+      2 * static_cast<size_t>(tbb::info::default_concurrency()) + 2;
+  // Pyramids the tracker is done with go back to the decode stage, which
+  // builds into their buffers instead of allocating fresh ones.
+  tbb::concurrent_queue<std::vector<cv::Mat>> spares;
+  int next = 0;
+  tbb::parallel_pipeline(
+      max_tokens,
+      tbb::make_filter<void, int>(tbb::filter_mode::serial_in_order,
+                                  [&](tbb::flow_control& fc) -> int {
+                                    if (next >= num_frames) {
+                                      fc.stop();
+                                      return 0;
+                                    }
+                                    return next++;
+                                  }) &
+          tbb::make_filter<int, Item>(
+              tbb::filter_mode::parallel,
+              [&](int frame) {
+                Item item;
+                item.frame = frame;
+                item.grey = load_grey(frame);
+                if (item.grey.empty() || item.grey.type() != CV_8UC1) {
+                  throw InputError("frame " + std::to_string(frame) +
+                                   ": loader returned no 8-bit grey image");
+                }
+                std::vector<cv::Mat> recycled;
+                if (spares.try_pop(recycled)) item.pyramid = std::move(recycled);
+                KltTracker::BuildPyramid(item.grey, options, &item.pyramid);
+                return item;
+              }) &
+          tbb::make_filter<Item, void>(
+              tbb::filter_mode::serial_in_order, [&](Item item) {
+                tracker.Track(item.frame, item.grey, std::move(item.pyramid));
+                std::vector<cv::Mat> spare = tracker.ReleaseSparePyramid();
+                if (!spare.empty()) spares.push(std::move(spare));
+              }));
+
+  TrackingReport report;
+  const KltFrameStats& totals = tracker.TotalStats();
+  report.frames = num_frames;
+  report.tracks_created = tracker.NumTracksCreated();
+  report.lost_forward_backward = totals.lost_forward_backward;
+  report.lost_lk = totals.lost_lk + totals.lost_error;
+  report.lost_border = totals.lost_border;
+  report.mean_features_per_frame =
+      static_cast<double>(totals.total) / num_frames;
+
+  std::vector<Track> result = tracker.FinishedTracks(2);
+  report.tracks_returned = static_cast<int64_t>(result.size());
+  if (!result.empty()) {
+    std::vector<size_t> lengths;
+    lengths.reserve(result.size());
+    double sum = 0.0;
+    for (const Track& t : result) {
+      lengths.push_back(t.observations.size());
+      sum += static_cast<double>(t.observations.size());
+    }
+    report.mean_track_length = sum / static_cast<double>(lengths.size());
+    const size_t mid = lengths.size() / 2;
+    std::nth_element(lengths.begin(), lengths.begin() + mid, lengths.end());
+    double median = static_cast<double>(lengths[mid]);
+    if (lengths.size() % 2 == 0) {
+      const size_t lower =
+          *std::max_element(lengths.begin(), lengths.begin() + mid);
+      median = 0.5 * (median + static_cast<double>(lower));
+    }
+    report.median_track_length = median;
+  }
+  if (tracks != nullptr) *tracks = std::move(result);
+  report.seconds = timer.ElapsedSeconds();
+  report.frames_per_second =
+      report.seconds > 0.0 ? num_frames / report.seconds : 0.0;
+  return report;
+}
+
+}  // namespace monomap

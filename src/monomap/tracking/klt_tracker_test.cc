@@ -1,0 +1,360 @@
+#include "monomap/tracking/klt_tracker.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <set>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
+
+#include "monomap/util/error.h"
+
+namespace monomap {
+namespace {
+
+constexpr int kWidth = 640;
+constexpr int kHeight = 480;
+
+// A corner-rich texture: smoothed noise (blobs) plus random rectangles and
+// discs, lightly blurred so sub-pixel warps resample it faithfully.
+cv::Mat MakeTexture(int width, int height, uint64_t seed) {
+  cv::RNG rng(seed);
+  cv::Mat noise(height, width, CV_32F);
+  rng.fill(noise, cv::RNG::NORMAL, 0.0, 1.0);
+  cv::GaussianBlur(noise, noise, cv::Size(0, 0), 2.5);
+  cv::Scalar mean, stddev;
+  cv::meanStdDev(noise, mean, stddev);
+  cv::Mat img = (noise - mean[0]) * (35.0 / stddev[0]) + 128.0;
+  const int shapes = width * height / 2500;
+  for (int i = 0; i < shapes; ++i) {
+    const cv::Point c(rng.uniform(0, width), rng.uniform(0, height));
+    const double grey = rng.uniform(30.0, 225.0);
+    if (rng.uniform(0, 2) == 0) {
+      const cv::Point d(rng.uniform(4, 30), rng.uniform(4, 30));
+      cv::rectangle(img, c - d, c + d, cv::Scalar(grey), cv::FILLED);
+    } else {
+      cv::circle(img, c, rng.uniform(3, 20), cv::Scalar(grey), cv::FILLED);
+    }
+  }
+  cv::GaussianBlur(img, img, cv::Size(0, 0), 1.0);
+  cv::Mat out;
+  img.convertTo(out, CV_8U);
+  return out;
+}
+
+// A sequence of views of one texture: frame k shows base pixel p at
+// warps[k] * (p, 1).
+struct Sequence {
+  std::vector<cv::Mat> frames;
+  std::vector<cv::Matx23d> warps;
+
+  // Where the feature seen at `px` in frame `from` is in frame `to`.
+  Eigen::Vector2d Predict(int from, const Eigen::Vector2d& px, int to) const {
+    cv::Matx23d inv;
+    cv::invertAffineTransform(warps[from], inv);
+    const cv::Vec3d q(px.x(), px.y(), 1.0);
+    const cv::Vec2d p = inv * q;
+    const cv::Vec2d r = warps[to] * cv::Vec3d(p[0], p[1], 1.0);
+    return Eigen::Vector2d(r[0], r[1]);
+  }
+};
+
+struct Motion {
+  double tx = 0, ty = 0;     // px per frame
+  double angle_deg = 0;      // per frame, about the image centre
+  double scale = 0;          // relative change per frame
+};
+
+Sequence MakeSequence(const cv::Mat& base, int num_frames,
+                      const Motion& motion) {
+  Sequence seq;
+  const cv::Point2d base_centre(base.cols / 2.0, base.rows / 2.0);
+  const cv::Point2d frame_centre(kWidth / 2.0, kHeight / 2.0);
+  for (int k = 0; k < num_frames; ++k) {
+    const double a = motion.angle_deg * k * CV_PI / 180.0;
+    const double s = 1.0 + motion.scale * k;
+    const double c = s * std::cos(a), n = s * std::sin(a);
+    // x' = s R (x - base_centre) + frame_centre + t.
+    const double tx = frame_centre.x + motion.tx * k;
+    const double ty = frame_centre.y + motion.ty * k;
+    cv::Matx23d w(c, -n, tx - (c * base_centre.x - n * base_centre.y),  //
+                  n, c, ty - (n * base_centre.x + c * base_centre.y));
+    cv::Mat frame;
+    cv::warpAffine(base, frame, w, cv::Size(kWidth, kHeight), cv::INTER_CUBIC);
+    seq.frames.push_back(frame);
+    seq.warps.push_back(w);
+  }
+  return seq;
+}
+
+double Percentile(std::vector<double> v, double q) {
+  if (v.empty()) return 0.0;
+  const size_t k = std::min(v.size() - 1, static_cast<size_t>(q * v.size()));
+  std::nth_element(v.begin(), v.begin() + k, v.end());
+  return v[k];
+}
+
+// Errors of every observation after the first against the ground truth.
+std::vector<double> TrackErrors(const std::vector<Track>& tracks,
+                                const Sequence& seq) {
+  std::vector<double> errors;
+  for (const Track& t : tracks) {
+    const Observation& first = t.observations.front();
+    for (size_t i = 1; i < t.observations.size(); ++i) {
+      const Observation& o = t.observations[i];
+      errors.push_back(
+          (seq.Predict(first.frame, first.px, o.frame) - o.px).norm());
+    }
+  }
+  return errors;
+}
+
+TEST(KltTrackerTest, SubPixelAccuracyUnderAffineMotion) {
+  const cv::Mat base = MakeTexture(1100, 900, 1);
+  const Sequence seq =
+      MakeSequence(base, 12, {0.73, -0.41, 0.25, 0.002});
+  KltTrackerOptions options;
+  KltTracker tracker(options);
+  for (int k = 0; k < 12; ++k) {
+    tracker.Track(k, seq.frames[k]);
+    EXPECT_GE(tracker.NumFeatures(), 0.9 * options.target_features);
+    EXPECT_LE(tracker.NumFeatures(), options.target_features);
+  }
+  const std::vector<double> errors =
+      TrackErrors(tracker.FinishedTracks(2), seq);
+  ASSERT_GT(errors.size(), 5000u);
+  const double median = Percentile(errors, 0.5);
+  const double p95 = Percentile(errors, 0.95);
+  EXPECT_LT(median, 0.1);
+  EXPECT_LT(p95, 0.3);
+  RecordProperty("median_error_px", std::to_string(median));
+  RecordProperty("p95_error_px", std::to_string(p95));
+  std::printf("affine: %zu observations, median %.4f px, p95 %.4f px\n",
+              errors.size(), median, p95);
+}
+
+TEST(KltTrackerTest, IdsAreUniqueAndPersist) {
+  const cv::Mat base = MakeTexture(1000, 800, 2);
+  const Sequence seq = MakeSequence(base, 10, {0.6, 0.35, 0.0, 0.0});
+  KltTrackerOptions options;
+  KltTracker tracker(options);
+  tracker.Track(0, seq.frames[0]);
+  const std::vector<KltFeature> initial = tracker.Features();
+  FeatureId max_id_so_far = -1;
+  for (const KltFeature& f : initial) max_id_so_far = std::max(max_id_so_far, f.id);
+  std::set<FeatureId> seen;
+  for (const KltFeature& f : initial) seen.insert(f.id);
+  for (int k = 1; k < 10; ++k) {
+    tracker.Track(k, seq.frames[k]);
+    const std::vector<KltFeature> features = tracker.Features();
+    std::set<FeatureId> ids;
+    FeatureId new_max = max_id_so_far;
+    for (const KltFeature& f : features) {
+      EXPECT_TRUE(ids.insert(f.id).second) << "duplicate id " << f.id;
+      // A new id is larger than every id handed out before: never reused.
+      if (!seen.count(f.id)) {
+        EXPECT_GT(f.id, max_id_so_far);
+        new_max = std::max(new_max, f.id);
+      }
+      seen.insert(f.id);
+    }
+    max_id_so_far = new_max;
+    // No two features on the same spot.
+    double closest = 1e9;
+    for (size_t i = 0; i < features.size(); ++i) {
+      for (size_t j = i + 1; j < features.size(); ++j) {
+        closest = std::min(closest, (features[i].px - features[j].px).norm());
+      }
+    }
+    EXPECT_GT(closest, 0.5 * options.min_distance_px) << "frame " << k;
+  }
+  // Features well inside the image all the time keep their id to the end.
+  std::set<FeatureId> alive_at_end;
+  for (const KltFeature& f : tracker.Features()) alive_at_end.insert(f.id);
+  int interior = 0, kept = 0;
+  for (const KltFeature& f : initial) {
+    const Eigen::Vector2d end = seq.Predict(0, f.px, 9);
+    const bool inside = std::min({f.px.x(), f.px.y(), end.x(), end.y()}) > 30 &&
+                        std::max(f.px.x(), end.x()) < kWidth - 30 &&
+                        std::max(f.px.y(), end.y()) < kHeight - 30;
+    if (!inside) continue;
+    ++interior;
+    if (alive_at_end.count(f.id)) ++kept;
+  }
+  ASSERT_GT(interior, 400);
+  EXPECT_GE(kept, 0.97 * interior);
+  // Tracks cover consecutive frames, each id once.
+  const std::vector<Track> tracks = tracker.FinishedTracks();
+  std::set<FeatureId> track_ids;
+  for (const Track& t : tracks) {
+    EXPECT_TRUE(track_ids.insert(t.id).second);
+    for (size_t i = 1; i < t.observations.size(); ++i) {
+      EXPECT_EQ(t.observations[i].frame, t.observations[i - 1].frame + 1);
+    }
+  }
+  EXPECT_EQ(static_cast<int64_t>(tracks.size()), tracker.NumTracksCreated());
+}
+
+TEST(KltTrackerTest, FeaturesLeavingTheImageAreDroppedAndReplaced) {
+  const cv::Mat base = MakeTexture(1400, 800, 3);
+  constexpr int kFrames = 30;
+  const Sequence seq = MakeSequence(base, kFrames, {-9.0, -2.5, 0.0, 0.0});
+  KltTrackerOptions options;
+  KltTracker tracker(options);
+  tracker.Track(0, seq.frames[0]);
+  const std::vector<KltFeature> initial = tracker.Features();
+  int lost_border = 0;
+  for (int k = 1; k < kFrames; ++k) {
+    tracker.Track(k, seq.frames[k]);
+    lost_border += tracker.LastFrameStats().lost_border;
+    EXPECT_GE(tracker.NumFeatures(), 0.9 * options.target_features)
+        << "frame " << k;
+    EXPECT_LE(tracker.NumFeatures(), options.target_features);
+  }
+  // Most initial features have left the view (270 px of 640) and are gone.
+  std::set<FeatureId> alive;
+  for (const KltFeature& f : tracker.Features()) alive.insert(f.id);
+  int gone = 0;
+  for (const KltFeature& f : initial) gone += alive.count(f.id) ? 0 : 1;
+  EXPECT_GE(gone, 0.35 * initial.size());
+  EXPECT_GE(lost_border, 0.3 * initial.size());
+  // They were replaced by new features (new ids).
+  EXPECT_GE(tracker.NumTracksCreated() - static_cast<int64_t>(initial.size()),
+            0.9 * gone);
+  std::printf("leaving: %zu initial, %d gone, %d lost at border, %lld ids\n",
+              initial.size(), gone, lost_border,
+              static_cast<long long>(tracker.NumTracksCreated()));
+
+  // No observation lies outside the image: tracks end at the border
+  // rather than sticking to it, and every position is correct.
+  const std::vector<Track> tracks = tracker.FinishedTracks(2);
+  double worst_outside = 0.0;
+  for (const Track& t : tracks) {
+    const Observation& first = t.observations.front();
+    for (const Observation& o : t.observations) {
+      const Eigen::Vector2d p = seq.Predict(first.frame, first.px, o.frame);
+      worst_outside = std::max({worst_outside, -p.x(), -p.y(),
+                                p.x() - (kWidth - 1), p.y() - (kHeight - 1)});
+    }
+  }
+  EXPECT_LE(worst_outside, 0.0);
+  const std::vector<double> errors = TrackErrors(tracks, seq);
+  EXPECT_LT(Percentile(errors, 0.5), 0.1);
+  EXPECT_LT(Percentile(errors, 0.99), 0.5);
+}
+
+TEST(KltTrackerTest, OccludedFeaturesAreDroppedByForwardBackwardCheck) {
+  const cv::Mat base = MakeTexture(1000, 800, 4);
+  const cv::Mat other = MakeTexture(kWidth, kHeight, 5);
+  constexpr int kFrames = 8, kOcclusionFrame = 5;
+  Sequence seq = MakeSequence(base, kFrames, {0.5, 0.3, 0.0, 0.0});
+  // From kOcclusionFrame on, a region shows different content (something
+  // moved in front of the scene).
+  const cv::Rect region(200, 120, 240, 200);
+  for (int k = kOcclusionFrame; k < kFrames; ++k) {
+    other(region).copyTo(seq.frames[k](region));
+  }
+  KltTrackerOptions options;
+  KltTracker tracker(options);
+  std::vector<KltFeature> before;
+  for (int k = 0; k < kFrames; ++k) {
+    if (k == kOcclusionFrame) before = tracker.Features();
+    tracker.Track(k, seq.frames[k]);
+    if (k == kOcclusionFrame) break;
+  }
+  const KltFrameStats stats = tracker.LastFrameStats();
+  std::set<FeatureId> after;
+  for (const KltFeature& f : tracker.Features()) after.insert(f.id);
+
+  // Features whose whole LK window was inside / outside the region.
+  const int half = options.window_size / 2 + 2;
+  auto inside = [&](const Eigen::Vector2d& p, int pad) {
+    return p.x() >= region.x + pad && p.x() <= region.x + region.width - pad &&
+           p.y() >= region.y + pad && p.y() <= region.y + region.height - pad;
+  };
+  int occluded = 0, occluded_kept = 0, clear = 0, clear_kept = 0;
+  for (const KltFeature& f : before) {
+    if (inside(f.px, half)) {
+      ++occluded;
+      occluded_kept += after.count(f.id) ? 1 : 0;
+    } else if (!inside(f.px, -half - 2)) {
+      ++clear;
+      clear_kept += after.count(f.id) ? 1 : 0;
+    }
+  }
+  ASSERT_GT(occluded, 40);
+  EXPECT_LE(occluded_kept, 0.1 * occluded);
+  // The forward-backward check is what catches them (LK itself converges
+  // on the new texture).
+  EXPECT_GE(stats.lost_forward_backward, 0.5 * occluded);
+  EXPECT_GE(clear_kept, 0.97 * clear);
+  std::printf("occlusion: %d occluded features, %d kept; lost fb %d, lk %d, "
+              "error %d\n",
+              occluded, occluded_kept, stats.lost_forward_backward,
+              stats.lost_lk, stats.lost_error);
+}
+
+TEST(KltTrackerTest, TrackFeaturesMatchesSerialTrackingAndReports) {
+  const cv::Mat base = MakeTexture(1100, 900, 6);
+  constexpr int kFrames = 15;
+  const Sequence seq = MakeSequence(base, kFrames, {1.3, 0.8, 0.2, 0.0});
+  KltTrackerOptions options;
+  options.target_features = 400;
+
+  KltTracker serial(options);
+  for (int k = 0; k < kFrames; ++k) serial.Track(k, seq.frames[k]);
+  const std::vector<Track> expected = serial.FinishedTracks(2);
+
+  std::vector<Track> tracks;
+  const TrackingReport report = TrackFeatures(
+      [&](int k) { return seq.frames[k].clone(); }, kFrames, options, &tracks);
+  ASSERT_EQ(tracks.size(), expected.size());
+  for (size_t i = 0; i < tracks.size(); ++i) {
+    ASSERT_EQ(tracks[i].id, expected[i].id);
+    ASSERT_EQ(tracks[i].observations.size(), expected[i].observations.size());
+    for (size_t j = 0; j < tracks[i].observations.size(); ++j) {
+      EXPECT_EQ(tracks[i].observations[j].frame,
+                expected[i].observations[j].frame);
+      EXPECT_EQ(tracks[i].observations[j].px, expected[i].observations[j].px);
+    }
+  }
+  EXPECT_EQ(report.frames, kFrames);
+  EXPECT_EQ(report.tracks_created, serial.NumTracksCreated());
+  EXPECT_EQ(report.tracks_returned, static_cast<int64_t>(tracks.size()));
+  EXPECT_GT(report.mean_track_length, 5.0);
+  EXPECT_LE(report.mean_track_length, kFrames);
+  EXPECT_GE(report.median_track_length, 2.0);
+  EXPECT_GE(report.mean_features_per_frame, 0.9 * options.target_features);
+  EXPECT_EQ(report.lost_forward_backward,
+            serial.TotalStats().lost_forward_backward);
+  EXPECT_GT(report.frames_per_second, 0.0);
+  const std::vector<double> errors = TrackErrors(tracks, seq);
+  EXPECT_LT(Percentile(errors, 0.5), 0.1);
+}
+
+TEST(KltTrackerTest, RejectsBadOptionsAndInput) {
+  KltTrackerOptions options;
+  options.window_size = 20;
+  EXPECT_THROW(options.Check(), OptionsError);
+  options = {};
+  options.forward_backward_threshold_px = 0.0;
+  EXPECT_THROW(KltTracker{options}, OptionsError);
+
+  KltTracker tracker;
+  const cv::Mat colour(kHeight, kWidth, CV_8UC3, cv::Scalar(0, 0, 0));
+  EXPECT_THROW(tracker.Track(0, colour), InputError);
+  const cv::Mat grey = MakeTexture(kWidth, kHeight, 7);
+  tracker.Track(3, grey);
+  EXPECT_THROW(tracker.Track(3, grey), InputError);
+  EXPECT_THROW(tracker.Track(4, grey(cv::Rect(0, 0, 320, 240)).clone()),
+               InputError);
+  EXPECT_THROW(TrackFeatures([&](int) { return grey; }, 0, {}, nullptr),
+               StageError);
+  EXPECT_THROW(TrackFeatures([&](int) { return colour; }, 3, {}, nullptr),
+               InputError);
+}
+
+}  // namespace
+}  // namespace monomap
