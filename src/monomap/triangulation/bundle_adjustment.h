@@ -1,0 +1,107 @@
+// Stage 2b of map building: bundle adjustment of the camera poses and the
+// triangulated landmarks, correcting odometry drift.
+//
+// Residuals:
+//  * reprojection error in raw (distorted) pixels: the plumb_bob distortion
+//    is applied inside the templated cost, so the error is measured where
+//    the KLT noise lives; under a robust loss (Huber or Cauchy);
+//  * a prior between consecutive frames on the relative motion
+//    cam_i_from_cam_{i+1} of the ORIGINAL odometry, weighted by sigmas that
+//    grow with the step length. A monocular camera cannot observe scale: the
+//    priors keep it (and keep unobserved frames in place).
+// The first pose is held fixed (the odometry is anchored at it), which fixes
+// the gauge. Intrinsics are not refined.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "monomap/camera/camera.h"
+#include "monomap/geometry/rigid3.h"
+#include "monomap/map/map.h"
+
+namespace monomap {
+
+struct BundleAdjustmentOptions {
+  // Off: poses and landmarks are returned unchanged (the report still
+  // gives the reprojection error).
+  bool enabled = true;
+  // Robust loss of the reprojection residuals: "huber", "cauchy" or
+  // "none".
+  std::string loss = "huber";
+  // Scale (px) of the robust loss: residuals beyond it are down-weighted.
+  double loss_scale_px = 1.0;
+  // Odometry prior, translation sigma per step (per axis): this fraction of
+  // the step length ...
+  double translation_sigma_fraction = 0.05;
+  // ... plus this floor (m), so standing still is not infinitely certain.
+  double translation_sigma_floor_m = 0.0002;
+  // Odometry prior, rotation sigma per step (per axis, degrees): this
+  // floor ...
+  double rotation_sigma_floor_deg = 0.02;
+  // ... plus this much per metre travelled in the step.
+  double rotation_sigma_deg_per_m = 1.0;
+  // Hold the first pose fixed (gauge). If false, the first pose gets an
+  // absolute prior with the floor sigmas instead.
+  bool fix_first_pose = true;
+  // Most landmarks in the joint adjustment (0: all). The poses need only a
+  // few thousand well-spread points; the cost grows with every point times
+  // its track length squared. The longest tracks are taken, spread evenly
+  // over the frames; the other landmarks are then refined one by one with
+  // the adjusted poses held fixed.
+  int max_points = 3000;
+  // Largest Levenberg-Marquardt iterations.
+  int max_num_iterations = 50;
+  // Ceres stops when the relative cost decrease is below this. The cost
+  // flattens after 2-4 iterations on drifting odometry; a tighter value
+  // costs iterations that move poses by micrometres.
+  double function_tolerance = 1e-4;
+  // Threads Ceres uses for Jacobians and the linear solver.
+  int num_threads = 2;
+  // Use ITERATIVE_SCHUR (preconditioned CG) instead of SPARSE_SCHUR: for
+  // very long sequences where the reduced camera system gets large.
+  bool iterative_schur = false;
+  // After adjustment, landmarks whose mean reprojection error (raw px)
+  // exceeds this are dropped (same meaning and default as
+  // TriangulationOptions::max_reprojection_error_px).
+  double max_reprojection_error_px = 2.0;
+  // Landmarks closer than this (m) to any observing camera, or behind it,
+  // after adjustment are dropped (as TriangulationOptions::min_depth_m).
+  double min_depth_m = 0.01;
+  // Print Ceres' per-iteration progress and full report to stdout.
+  bool verbose = false;
+  // Throws OptionsError naming the field if a value makes no sense.
+  void Check() const;
+};
+
+struct BundleAdjustmentReport {
+  int num_poses = 0;          // pose blocks in the problem
+  int num_points = 0;         // landmarks given
+  int num_points_joint = 0;   // of which in the joint adjustment
+  int num_residuals = 0;      // reprojection residual blocks (observations)
+  int num_priors = 0;         // odometry prior residual blocks
+  double initial_rms_error_px = 0.0;     // reprojection, all observations
+  double final_rms_error_px = 0.0;
+  double initial_median_error_px = 0.0;
+  double final_median_error_px = 0.0;
+  int iterations = 0;
+  std::string termination;    // Ceres termination type, "disabled" if off
+  int num_dropped = 0;        // landmarks dropped after adjustment
+  double mean_pose_change_m = 0.0;    // mean camera centre displacement
+  double mean_pose_change_deg = 0.0;  // mean rotation change
+  double seconds = 0.0;
+};
+
+// Adjusts *world_from_cam (indexed by frame, odometry on input) and
+// *landmarks (tracks are matched to landmarks by id; only landmarks passed
+// in are adjusted). Landmark fields (error, angle, depth) are updated, and
+// landmarks with too large an error afterwards are removed (order of the
+// others kept). Throws InputError if a landmark has no track or a track
+// refers to a frame without pose, OptionsError for bad options.
+BundleAdjustmentReport BundleAdjust(const Camera& camera,
+                                    const std::vector<Track>& tracks,
+                                    const BundleAdjustmentOptions& options,
+                                    std::vector<Rigid3d>* world_from_cam,
+                                    std::vector<Landmark>* landmarks);
+
+}  // namespace monomap

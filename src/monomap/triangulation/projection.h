@@ -1,0 +1,41 @@
+// Templated plumb_bob projection shared by the triangulation refinement and
+// bundle adjustment, so both minimise the same error: the distance in raw
+// (distorted) pixels between a projected point and its observation. It
+// mirrors Camera::ImageFromCam but works on ceres::Jet for autodiff.
+#pragma once
+
+#include "monomap/camera/camera.h"
+
+namespace monomap::internal {
+
+// Intrinsics as a flat array: fx, fy, cx, cy, k1, k2, p1, p2, k3.
+struct Intrinsics {
+  double v[9];
+  explicit Intrinsics(const Camera& c)
+      : v{c.fx,
+          c.fy,
+          c.cx,
+          c.cy,
+          c.distortion[0],
+          c.distortion[1],
+          c.distortion[2],
+          c.distortion[3],
+          c.distortion[4]} {}
+};
+
+// Camera-frame point -> raw pixel (px[0], px[1]). Caller checks z > 0.
+template <typename T>
+inline void ProjectToImage(const Intrinsics& in, const T* x_in_cam, T* px) {
+  const T x = x_in_cam[0] / x_in_cam[2];
+  const T y = x_in_cam[1] / x_in_cam[2];
+  const double k1 = in.v[4], k2 = in.v[5], p1 = in.v[6], p2 = in.v[7],
+               k3 = in.v[8];
+  const T r2 = x * x + y * y;
+  const T radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3));
+  const T xd = x * radial + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x);
+  const T yd = y * radial + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y;
+  px[0] = in.v[0] * xd + in.v[2];
+  px[1] = in.v[1] * yd + in.v[3];
+}
+
+}  // namespace monomap::internal

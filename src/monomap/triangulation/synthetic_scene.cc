@@ -1,0 +1,107 @@
+#include "monomap/triangulation/synthetic_scene.h"
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+#include "monomap/util/error.h"
+
+namespace monomap {
+
+constexpr double kDegToRad = M_PI / 180.0;
+
+Camera SyntheticCamera() {
+  Camera c;
+  c.width = 752;
+  c.height = 480;
+  c.fx = 420.0;
+  c.fy = 420.0;
+  c.cx = 375.5;
+  c.cy = 239.5;
+  c.distortion = {-0.3, 0.08, 0.0005, -0.0003, 0.0};
+  return c;
+}
+
+SyntheticScene MakeSyntheticScene(const SyntheticSceneOptions& options) {
+  CheckOption(options.num_frames >= 2, "num_frames", "must be >= 2");
+  CheckOption(options.min_track_length >= 1 &&
+                  options.max_track_length >= options.min_track_length,
+              "min_track_length/max_track_length", "bad range");
+  SyntheticScene scene;
+  scene.camera = SyntheticCamera();
+  const Camera& camera = scene.camera;
+  std::mt19937_64 rng(options.seed);
+  // Trajectory: sideways travel with a gentle vertical wave and a few
+  // degrees of yaw/pitch wobble, so rotations are not all identical.
+  const int n = options.num_frames;
+  for (int i = 0; i < n; ++i) {
+    const double phase = 2.0 * M_PI * i / 60.0;
+    const Eigen::Vector3d center(options.step_m * i, 0.005 * std::sin(phase),
+                                 0.003 * std::cos(0.7 * phase));
+    const Eigen::Quaterniond rotation =
+        QuaternionFromRotationVector(Eigen::Vector3d(
+            1.5 * kDegToRad * std::sin(0.5 * phase),
+            3.0 * kDegToRad * std::sin(phase), 1.0 * kDegToRad * std::cos(phase)));
+    scene.world_from_cam.emplace_back(rotation, center);
+  }
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  for (int t = 0; t < options.num_tracks; ++t) {
+    int length = options.min_track_length +
+                 static_cast<int>(uniform(rng) * (options.max_track_length -
+                                                  options.min_track_length + 1));
+    length = std::clamp(length, 1, n);
+    const int start = static_cast<int>(uniform(rng) * (n - length + 1));
+    const int mid = std::min(start + length / 2, n - 1);
+    // A pixel in the central part of the middle view, so the point stays in
+    // the image over the whole track, back-projected to a random depth.
+    const Eigen::Vector2d px(camera.cx + (uniform(rng) - 0.5) * 440.0,
+                             camera.cy + (uniform(rng) - 0.5) * 360.0);
+    const double depth = options.min_depth_m +
+                         uniform(rng) * (options.max_depth_m - options.min_depth_m);
+    const Eigen::Vector3d x_in_cam =
+        Eigen::Vector3d(camera.NormalizedFromImage(px).homogeneous()) * depth;
+    const Eigen::Vector3d x = scene.world_from_cam[mid] * x_in_cam;
+    Track track;
+    track.id = t;
+    for (int f = start; f < start + length; ++f) {
+      const Eigen::Vector3d xc = scene.world_from_cam[f].Inverse() * x;
+      if (xc.z() <= 0) continue;
+      Eigen::Vector2d obs = camera.ImageFromCam(xc);
+      if (!camera.InImage(obs, 2.0)) continue;
+      obs += options.pixel_noise_px * Eigen::Vector2d(noise(rng), noise(rng));
+      track.observations.push_back({f, obs});
+    }
+    scene.points.push_back(x);
+    scene.tracks.push_back(std::move(track));
+  }
+  return scene;
+}
+
+std::vector<Rigid3d> SimulateOdometryDrift(
+    const std::vector<Rigid3d>& world_from_cam,
+    const OdometryDriftOptions& options) {
+  std::vector<Rigid3d> odometry;
+  if (world_from_cam.empty()) return odometry;
+  std::mt19937_64 rng(options.seed);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  const Eigen::Vector3d drift_axis = Eigen::Vector3d(0.3, 1.0, 0.2).normalized();
+  odometry.push_back(world_from_cam[0]);
+  for (size_t i = 0; i + 1 < world_from_cam.size(); ++i) {
+    const Rigid3d delta = world_from_cam[i].Inverse() * world_from_cam[i + 1];
+    const double step = delta.translation.norm();
+    const Eigen::Vector3d t =
+        (1.0 + options.scale_error) * delta.translation +
+        options.translation_noise_fraction * step *
+            Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
+    const Eigen::Vector3d w =
+        drift_axis * options.rotation_drift_deg_per_m * step * kDegToRad +
+        options.rotation_noise_deg * kDegToRad *
+            Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
+    const Rigid3d noisy(delta.rotation * QuaternionFromRotationVector(w), t);
+    odometry.push_back(odometry.back() * noisy);
+  }
+  return odometry;
+}
+
+}  // namespace monomap

@@ -1,0 +1,302 @@
+#include "monomap/triangulation/triangulator.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include <ceres/jet.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <Eigen/Cholesky>
+
+#include "monomap/geometry/triangulation.h"
+#include "monomap/triangulation/projection.h"
+#include "monomap/util/error.h"
+#include "monomap/util/progress.h"
+
+namespace monomap {
+namespace {
+
+constexpr double kRadToDeg = 180.0 / M_PI;
+
+enum class Outcome : uint8_t {
+  kAccepted,
+  kShort,
+  kFailed,
+  kCheirality,
+  kAngle,
+  kReprojection
+};
+
+// Sum of squared pixel residuals and, if j_t_j/j_t_r are given, the normal
+// equations of the 3-parameter problem. Returns +inf if the point is not in
+// front of every camera, which the refinement treats as a rejected step.
+double PointCost(const internal::Intrinsics& intrinsics,
+                 const std::vector<Rigid3d>& cams,
+                 const std::vector<Eigen::Vector2d>& observed,
+                 const Eigen::Vector3d& x, Eigen::Matrix3d* j_t_j,
+                 Eigen::Vector3d* j_t_r) {
+  using Jet = ceres::Jet<double, 3>;
+  double cost = 0.0;
+  if (j_t_j != nullptr) {
+    j_t_j->setZero();
+    j_t_r->setZero();
+  }
+  const Eigen::Matrix<Jet, 3, 1> xj(Jet(x.x(), 0), Jet(x.y(), 1),
+                                    Jet(x.z(), 2));
+  for (size_t i = 0; i < cams.size(); ++i) {
+    const Eigen::Matrix3d r = cams[i].RotationMatrix();
+    const Eigen::Vector3d xc = r * x + cams[i].translation;
+    if (!(xc.z() > 0.0)) return std::numeric_limits<double>::infinity();
+    if (j_t_j == nullptr) {
+      double px[2];
+      internal::ProjectToImage(intrinsics, xc.data(), px);
+      cost += (Eigen::Vector2d(px[0], px[1]) - observed[i]).squaredNorm();
+      continue;
+    }
+    const Eigen::Matrix<Jet, 3, 1> xcj =
+        r.cast<Jet>() * xj + cams[i].translation.cast<Jet>();
+    Jet px[2];
+    internal::ProjectToImage(intrinsics, xcj.data(), px);
+    for (int k = 0; k < 2; ++k) {
+      const double res = px[k].a - observed[i][k];
+      cost += res * res;
+      *j_t_j += px[k].v * px[k].v.transpose();
+      *j_t_r += px[k].v * res;
+    }
+  }
+  return cost;
+}
+
+// Levenberg-Marquardt on the point only (poses fixed): a 3x3 system per
+// iteration, far cheaper than setting up a Ceres problem per track.
+void RefinePointLm(const internal::Intrinsics& intrinsics,
+                 const std::vector<Rigid3d>& cams,
+                 const std::vector<Eigen::Vector2d>& observed,
+                 const TriangulationOptions& options, Eigen::Vector3d* x) {
+  const Eigen::Vector3d center0 = cams[0].Inverse().translation;
+  double lambda = 1e-4;
+  Eigen::Matrix3d jtj;
+  Eigen::Vector3d jtr;
+  double cost = PointCost(intrinsics, cams, observed, *x, &jtj, &jtr);
+  if (!std::isfinite(cost)) return;
+  for (int iter = 0; iter < options.max_refinement_iterations; ++iter) {
+    Eigen::Matrix3d a = jtj;
+    a.diagonal() *= 1.0 + lambda;
+    const Eigen::Vector3d step = a.ldlt().solve(-jtr);
+    if (!step.allFinite()) return;
+    const Eigen::Vector3d candidate = *x + step;
+    const double new_cost =
+        PointCost(intrinsics, cams, observed, candidate, nullptr, nullptr);
+    if (new_cost < cost) {
+      *x = candidate;
+      lambda = std::max(lambda * 0.1, 1e-10);
+      if (step.norm() <
+              options.refinement_tolerance * (*x - center0).norm() ||
+          cost - new_cost < 1e-12 * cost) {
+        return;
+      }
+      cost = PointCost(intrinsics, cams, observed, *x, &jtj, &jtr);
+    } else {
+      lambda *= 10.0;
+      if (lambda > 1e8) return;  // no descent left: at the minimum
+    }
+  }
+}
+
+}  // namespace
+
+void TriangulationOptions::Check() const {
+  CheckOption(min_track_length >= 2, "min_track_length", "must be >= 2");
+  CheckOption(max_reprojection_error_px > 0, "max_reprojection_error_px",
+              "must be positive");
+  CheckOption(max_observation_error_px >= max_reprojection_error_px,
+              "max_observation_error_px",
+              "must be >= max_reprojection_error_px");
+  CheckOption(min_triangulation_angle_deg >= 0 &&
+                  min_triangulation_angle_deg < 90,
+              "min_triangulation_angle_deg", "must be in [0, 90)");
+  CheckOption(min_depth_m > 0, "min_depth_m", "must be positive");
+  CheckOption(max_depth_m > min_depth_m, "max_depth_m",
+              "must be > min_depth_m");
+  CheckOption(max_refinement_iterations >= 0, "max_refinement_iterations",
+              "must be >= 0");
+  CheckOption(refinement_tolerance > 0, "refinement_tolerance",
+              "must be positive");
+}
+
+void RefinePoint(const Camera& camera,
+                 const std::vector<Rigid3d>& cams_from_world,
+                 const Track& track, const TriangulationOptions& options,
+                 Eigen::Vector3d* x_in_world) {
+  if (track.observations.empty()) return;
+  std::vector<Rigid3d> cams;
+  std::vector<Eigen::Vector2d> observed;
+  for (const Observation& obs : track.observations) {
+    cams.push_back(cams_from_world[obs.frame]);
+    observed.push_back(obs.px);
+  }
+  RefinePointLm(internal::Intrinsics(camera), cams, observed, options,
+                x_in_world);
+}
+
+PointStatistics EvaluatePoint(const Camera& camera,
+                              const std::vector<Rigid3d>& cams_from_world,
+                              const Track& track,
+                              const Eigen::Vector3d& x_in_world) {
+  PointStatistics s;
+  s.min_depth_m = std::numeric_limits<double>::infinity();
+  s.max_depth_m = -std::numeric_limits<double>::infinity();
+  std::vector<Rigid3d> cams;
+  cams.reserve(track.observations.size());
+  double sum_error = 0.0;
+  double sum_distance = 0.0;
+  for (const Observation& obs : track.observations) {
+    const Rigid3d& cam = cams_from_world[obs.frame];
+    cams.push_back(cam);
+    const Eigen::Vector3d xc = cam * x_in_world;
+    s.min_depth_m = std::min(s.min_depth_m, xc.z());
+    s.max_depth_m = std::max(s.max_depth_m, xc.z());
+    sum_distance += xc.norm();
+    const double error =
+        xc.z() > 0 ? (camera.ImageFromCam(xc) - obs.px).norm()
+                   : std::numeric_limits<double>::infinity();
+    sum_error += error;
+    s.max_error_px = std::max(s.max_error_px, error);
+  }
+  const double n = std::max<size_t>(1, track.observations.size());
+  s.mean_error_px = sum_error / n;
+  s.mean_distance_m = sum_distance / n;
+  s.triangulation_angle_deg =
+      MaxTriangulationAngle(cams, x_in_world) * kRadToDeg;
+  return s;
+}
+
+TriangulationReport TriangulateTracks(const Camera& camera,
+                                      const std::vector<Rigid3d>& world_from_cam,
+                                      const std::vector<Track>& tracks,
+                                      const TriangulationOptions& options,
+                                      std::vector<Landmark>* landmarks) {
+  options.Check();
+  camera.Check();
+  const Timer timer;
+  const int num_frames = static_cast<int>(world_from_cam.size());
+  for (const Track& track : tracks) {
+    for (const Observation& obs : track.observations) {
+      if (obs.frame < 0 || obs.frame >= num_frames) {
+        throw InputError("track " + std::to_string(track.id) +
+                         " observed in frame " + std::to_string(obs.frame) +
+                         " which has no pose (" + std::to_string(num_frames) +
+                         " poses)");
+      }
+    }
+  }
+  std::vector<Rigid3d> cams_from_world(world_from_cam.size());
+  for (size_t i = 0; i < world_from_cam.size(); ++i) {
+    cams_from_world[i] = world_from_cam[i].Inverse();
+  }
+  const internal::Intrinsics intrinsics(camera);
+
+  std::vector<Outcome> outcomes(tracks.size(), Outcome::kFailed);
+  std::vector<Landmark> candidates(tracks.size());
+  tbb::parallel_for(
+      tbb::blocked_range<size_t>(0, tracks.size(), 64),
+      [&](const tbb::blocked_range<size_t>& range) {
+        std::vector<Rigid3d> cams;
+        std::vector<Eigen::Vector2d> normalized, observed;
+        for (size_t t = range.begin(); t != range.end(); ++t) {
+          const Track& track = tracks[t];
+          const int n = static_cast<int>(track.observations.size());
+          if (n < options.min_track_length) {
+            outcomes[t] = Outcome::kShort;
+            continue;
+          }
+          cams.clear();
+          normalized.clear();
+          observed.clear();
+          for (const Observation& obs : track.observations) {
+            cams.push_back(cams_from_world[obs.frame]);
+            normalized.push_back(camera.NormalizedFromImage(obs.px));
+            observed.push_back(obs.px);
+          }
+          Eigen::Vector3d x;
+          if (!TriangulateLinear(cams, normalized, &x)) {
+            outcomes[t] = Outcome::kFailed;
+            continue;
+          }
+          // Cheirality of the linear estimate first: refining a point
+          // behind the cameras would only chase a mirrored solution.
+          bool in_front = true;
+          for (const Rigid3d& cam : cams) {
+            if (DepthInCamera(cam, x) < options.min_depth_m) {
+              in_front = false;
+              break;
+            }
+          }
+          if (!in_front) {
+            outcomes[t] = Outcome::kCheirality;
+            continue;
+          }
+          if (options.nonlinear_refinement) {
+            RefinePointLm(intrinsics, cams, observed, options, &x);
+          }
+          if (!x.allFinite()) {
+            outcomes[t] = Outcome::kFailed;
+            continue;
+          }
+          const PointStatistics s =
+              EvaluatePoint(camera, cams_from_world, track, x);
+          if (s.min_depth_m < options.min_depth_m ||
+              s.max_depth_m > options.max_depth_m) {
+            outcomes[t] = Outcome::kCheirality;
+          } else if (s.triangulation_angle_deg <
+                     options.min_triangulation_angle_deg) {
+            outcomes[t] = Outcome::kAngle;
+          } else if (s.mean_error_px > options.max_reprojection_error_px ||
+                     s.max_error_px > options.max_observation_error_px) {
+            outcomes[t] = Outcome::kReprojection;
+          } else {
+            outcomes[t] = Outcome::kAccepted;
+            Landmark& l = candidates[t];
+            l.id = track.id;
+            l.x_in_world = x;
+            l.num_observations = n;
+            l.mean_reprojection_error_px = s.mean_error_px;
+            l.triangulation_angle_deg = s.triangulation_angle_deg;
+            l.mean_depth_m = s.mean_distance_m;
+          }
+        }
+      });
+
+  TriangulationReport report;
+  report.num_tracks = static_cast<int>(tracks.size());
+  landmarks->clear();
+  std::vector<double> errors;
+  for (size_t t = 0; t < tracks.size(); ++t) {
+    switch (outcomes[t]) {
+      case Outcome::kAccepted:
+        landmarks->push_back(candidates[t]);
+        errors.push_back(candidates[t].mean_reprojection_error_px);
+        break;
+      case Outcome::kShort: ++report.rejected_short; break;
+      case Outcome::kFailed: ++report.rejected_failed; break;
+      case Outcome::kCheirality: ++report.rejected_cheirality; break;
+      case Outcome::kAngle: ++report.rejected_angle; break;
+      case Outcome::kReprojection: ++report.rejected_reprojection; break;
+    }
+  }
+  report.num_points = static_cast<int>(landmarks->size());
+  if (!errors.empty()) {
+    double sum = 0.0;
+    for (double e : errors) sum += e;
+    report.mean_reprojection_error_px = sum / errors.size();
+    std::nth_element(errors.begin(), errors.begin() + errors.size() / 2,
+                     errors.end());
+    report.median_reprojection_error_px = errors[errors.size() / 2];
+  }
+  report.seconds = timer.ElapsedSeconds();
+  return report;
+}
+
+}  // namespace monomap
