@@ -1,0 +1,126 @@
+// One update of the localization filter on the synthetic room of
+// localization/test_scene.h (floor + 4 walls, 320x240 live camera with
+// distortion): predict + render (80x60) + weigh + resample for MCL with a
+// fixed count of 1000 particles, and the same plus Monte Carlo Correction
+// of the 8 heaviest particles (160x120 renders, KLT, PnP) and merging for
+// MCC. Also the parts: scoring 1000 renders, one MCC correction.
+//
+//   build-loc/bench/localization_bench --benchmark_counters_tabular=true
+#include <vector>
+
+#include <benchmark/benchmark.h>
+
+#include "monomap/localization/localizer.h"
+#include "monomap/localization/test_scene.h"
+
+namespace monomap {
+namespace {
+
+struct Scene {
+  Map map = test_scene::RoomMap();
+  Camera camera = test_scene::LiveCamera();
+  Rigid3d mount = test_scene::BaseFromCam();
+  Renderer renderer{map};
+  Pose2d base{0.5, 0.2, 0.4};
+  Rigid3d truth = WorldFromCamOfBase(base, mount);
+  cv::Mat live = test_scene::LiveImage(renderer, camera, truth, 0.8, 15, 2.0, 1);
+};
+
+const Scene& GetScene() {
+  static const Scene scene;
+  return scene;
+}
+
+void BM_Update(benchmark::State& state, LocalizationMethod method) {
+  const Scene& s = GetScene();
+  LocalizerOptions o;
+  o.method = method;
+  o.state = LocalizationState::kPlanar;
+  o.num_particles = static_cast<int>(state.range(0));
+  o.use_kld = false;  // a fixed count, to time what is asked
+  o.init_spread_m = 0.05;
+  Localizer loc(s.map, s.camera, o, s.mount);
+  loc.InitializeAtPose(s.truth);
+  OdometryIncrement odo;
+  odo.base_prev = {0, 0, 0};
+  odo.base_cur = {0.0, 0, 0};
+  loc.Step(s.live, odo);  // first step: no prediction
+  double weighed = 0, ess = 0, weigh_ms = 0, mcc_ms = 0;
+  for (auto _ : state) {
+    const LocalizerEstimate e = loc.Step(s.live, odo);
+    benchmark::DoNotOptimize(e.world_from_cam.translation.x());
+    weighed += e.stats.particles_weighed;
+    ess += e.stats.ess;
+    weigh_ms += 1e3 * e.stats.weigh_seconds;
+    mcc_ms += 1e3 * e.stats.mcc_seconds;
+  }
+  state.counters["weigh_ms"] = weigh_ms / state.iterations();
+  state.counters["mcc_ms"] = mcc_ms / state.iterations();
+  state.counters["weighed"] = weighed / state.iterations();
+  state.counters["ess"] = ess / state.iterations();
+}
+
+void BM_MclUpdate(benchmark::State& state) {
+  BM_Update(state, LocalizationMethod::kMcl);
+}
+void BM_MccUpdate(benchmark::State& state) {
+  BM_Update(state, LocalizationMethod::kMcc);
+}
+BENCHMARK(BM_MclUpdate)->Arg(1000)->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK(BM_MccUpdate)->Arg(1000)->Arg(200)->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+// Rendering + NCC of 1000 poses (parallel), without the filter around it.
+void BM_ScoreBatch(benchmark::State& state) {
+  const Scene& s = GetScene();
+  const MeasurementModel model(&s.renderer, s.camera);
+  const cv::Mat live = model.PrepareLive(s.live);
+  std::vector<Rigid3d> poses;
+  Rng rng(1);
+  std::normal_distribution<double> n(0.0, 0.05);
+  for (int i = 0; i < state.range(0); ++i) {
+    poses.push_back(WorldFromCamOfBase(
+        {s.base.x + n(rng), s.base.y + n(rng), s.base.yaw + n(rng)}, s.mount));
+  }
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(model.ScoreBatch(live, poses).data());
+  }
+}
+BENCHMARK(BM_ScoreBatch)->Arg(1000)->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+// One render + NCC on the calling thread (the per-particle cost).
+void BM_ScoreOne(benchmark::State& state) {
+  const Scene& s = GetScene();
+  const MeasurementModel model(&s.renderer, s.camera);
+  const cv::Mat live = model.PrepareLive(s.live);
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(model.Score(live, s.truth).ncc);
+  }
+}
+BENCHMARK(BM_ScoreOne)->Unit(benchmark::kMicrosecond);
+
+// One Monte Carlo Correction (2 render-track-solve rounds at 160x120).
+void BM_MccCorrect(benchmark::State& state) {
+  const Scene& s = GetScene();
+  const MonteCarloCorrector mcc(&s.renderer, s.camera);
+  const LiveImagePreparer prep(s.camera);
+  const cv::Mat live = LiveImagePreparer::Downscale(
+      prep.Undistort(s.live), mcc.options().width, mcc.options().height);
+  const Rigid3d start = WorldFromCamOfBase(
+      {s.base.x + 0.02, s.base.y - 0.01, s.base.yaw + 0.017}, s.mount);
+  int accepted = 0;
+  for (auto _ : state) {
+    const MccResult r = mcc.Correct(live, start);
+    accepted += r.accepted;
+  }
+  state.counters["accepted"] =
+      static_cast<double>(accepted) / state.iterations();
+}
+BENCHMARK(BM_MccCorrect)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+}  // namespace monomap
+
+BENCHMARK_MAIN();

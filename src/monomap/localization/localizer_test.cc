@@ -1,0 +1,313 @@
+#include "monomap/localization/localizer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+
+#include <unistd.h>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include "monomap/localization/test_scene.h"
+#include "monomap/util/error.h"
+
+namespace monomap {
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+// Composes a planar motion (forward, left, turn) given in the base frame.
+Pose2d Compose(const Pose2d& a, double fwd, double left, double turn) {
+  return {a.x + fwd * std::cos(a.yaw) - left * std::sin(a.yaw),
+          a.y + fwd * std::sin(a.yaw) + left * std::cos(a.yaw),
+          WrapAngle(a.yaw + turn)};
+}
+
+// A robot drive: ground truth and drifting odometry (5 % scale error on
+// translation and 10 % on rotation, plus noise).
+struct Drive {
+  std::vector<Pose2d> truth, odometry;
+};
+
+Drive MakeDrive(const Pose2d& start, int steps, double step_m,
+                double turn_rad, uint64_t seed) {
+  Drive d;
+  Rng rng(seed);
+  std::normal_distribution<double> n(0.0, 1.0);
+  d.truth.push_back(start);
+  d.odometry.push_back({0, 0, 0});  // odometry has its own origin
+  for (int i = 1; i < steps; ++i) {
+    d.truth.push_back(Compose(d.truth.back(), step_m, 0, turn_rad));
+    d.odometry.push_back(Compose(d.odometry.back(),
+                                 step_m * (1.05 + 0.02 * n(rng)),
+                                 0.002 * n(rng),
+                                 turn_rad * 1.1 + 0.002 * n(rng)));
+  }
+  return d;
+}
+
+class LocalizerTest : public ::testing::Test {
+ public:
+  LocalizerTest()
+      : map_(test_scene::RoomMap()),
+        camera_(test_scene::LiveCamera()),
+        mount_(test_scene::BaseFromCam()),
+        renderer_(map_) {}
+
+  // Runs the filter over the drive; returns the per-step translation
+  // errors of the camera estimate.
+  std::vector<double> Run(const Drive& drive, Localizer* loc,
+                          std::vector<LocalizerStepStats>* stats = nullptr) {
+    std::vector<double> errors;
+    for (size_t i = 0; i < drive.truth.size(); ++i) {
+      const Rigid3d truth = WorldFromCamOfBase(drive.truth[i], mount_);
+      const cv::Mat raw = test_scene::LiveImage(
+          renderer_, camera_, truth, 0.85 + 0.1 * std::sin(i * 0.7), 10, 2.0,
+          100 + i);
+      OdometryIncrement odo;
+      if (i > 0) {
+        odo.base_prev = drive.odometry[i - 1];
+        odo.base_cur = drive.odometry[i];
+        odo.cam_prev_from_cam_cur =
+            WorldFromCamOfBase(drive.odometry[i - 1], mount_).Inverse() *
+            WorldFromCamOfBase(drive.odometry[i], mount_);
+      }
+      const LocalizerEstimate e = loc->Step(raw, odo);
+      errors.push_back((e.world_from_cam.translation - truth.translation)
+                           .norm());
+      if (stats) stats->push_back(e.stats);
+    }
+    return errors;
+  }
+
+  const Map& map() const { return map_; }
+  const Camera& camera() const { return camera_; }
+  const Rigid3d& mount() const { return mount_; }
+
+  Map map_;
+  Camera camera_;
+  Rigid3d mount_;
+  Renderer renderer_;
+};
+
+double Max(const std::vector<double>& v) {
+  return *std::max_element(v.begin(), v.end());
+}
+
+TEST_F(LocalizerTest, PlanarMclTracksFromAPose) {
+  LocalizerOptions o;
+  o.method = LocalizationMethod::kMcl;
+  o.state = LocalizationState::kPlanar;
+  o.num_particles = 500;
+  o.kld.max_particles = 500;
+  o.init_spread_m = 0.05;
+  o.injection_fraction = 0.0;
+  o.seed = 3;
+  Localizer loc(map_, camera_, o, mount_);
+  const Drive drive = MakeDrive({0.0, 0.0, 0.1}, 30, 0.03, 1.0 * kDeg, 1);
+  loc.InitializeAtPose(WorldFromCamOfBase(drive.truth[0], mount_));
+  std::vector<LocalizerStepStats> stats;
+  const std::vector<double> e = Run(drive, &loc, &stats);
+  double sum = 0;
+  for (double x : e) sum += x;
+  std::printf("MCL planar tracking: mean %.1f mm, max %.1f mm, last %.1f mm, "
+              "particles %d\n",
+              1e3 * sum / e.size(), 1e3 * Max(e), 1e3 * e.back(),
+              stats.back().particles);
+  EXPECT_LT(Max(std::vector<double>(e.begin() + 3, e.end())), 0.02);
+  EXPECT_LT(sum / e.size(), 0.012);
+}
+
+TEST_F(LocalizerTest, PlanarMccTracksFromAPose) {
+  LocalizerOptions o;
+  o.method = LocalizationMethod::kMcc;
+  o.state = LocalizationState::kPlanar;
+  o.num_particles = 300;
+  o.kld.max_particles = 300;
+  o.init_spread_m = 0.05;
+  o.seed = 4;
+  Localizer loc(map_, camera_, o, mount_);
+  const Drive drive = MakeDrive({0.2, -0.3, -0.4}, 30, 0.03, 1.5 * kDeg, 2);
+  loc.InitializeAtPose(WorldFromCamOfBase(drive.truth[0], mount_));
+  std::vector<LocalizerStepStats> stats;
+  const std::vector<double> e = Run(drive, &loc, &stats);
+  int accepted = 0;
+  for (const auto& s : stats) accepted += s.mcc_accepted;
+  double sum = 0;
+  for (double x : e) sum += x;
+  std::printf("MCC planar tracking: mean %.1f mm, max %.1f mm, last %.1f mm, "
+              "mcc accepted %d, particles %d\n",
+              1e3 * sum / e.size(), 1e3 * Max(e), 1e3 * e.back(), accepted,
+              stats.back().particles);
+  EXPECT_LT(Max(e), 0.02);
+  EXPECT_LT(sum / e.size(), 0.005);
+  EXPECT_GT(accepted, 30);
+}
+
+TEST_F(LocalizerTest, SixDofMccTracksFromAPose) {
+  LocalizerOptions o;
+  o.method = LocalizationMethod::kMcc;
+  o.state = LocalizationState::k6Dof;
+  o.num_particles = 300;
+  o.kld.max_particles = 300;
+  o.init_spread_m = 0.03;
+  o.init_spread_deg = 2.0;
+  o.seed = 5;
+  Localizer loc(map_, camera_, o);
+  const Drive drive = MakeDrive({0.5, 0.5, 2.0}, 25, 0.03, -1.0 * kDeg, 3);
+  loc.InitializeAtPose(WorldFromCamOfBase(drive.truth[0], mount_));
+  const std::vector<double> e = Run(drive, &loc);
+  std::printf("MCC 6dof tracking: max %.1f mm, last %.1f mm\n", 1e3 * Max(e),
+              1e3 * e.back());
+  EXPECT_LT(Max(std::vector<double>(e.begin() + 2, e.end())), 0.02);
+  EXPECT_LT(e.back(), 0.01);
+}
+
+void GlobalInitCase(LocalizerTest* t, LocalizationMethod method,
+                    std::vector<double>* e,
+                    std::vector<LocalizerStepStats>* stats) {
+  LocalizerOptions o;
+  o.method = method;
+  o.state = LocalizationState::kPlanar;
+  o.init = LocalizationInit::kGlobal;
+  o.num_particles = 3000;
+  o.kld.max_particles = 3000;
+  o.kld.min_particles = 200;
+  o.mcc_top_k = 10;
+  // A 1 x 1 m area with yaw unknown.
+  o.area_min = {0.0, -0.5};
+  o.area_max = {1.0, 0.5};
+  o.seed = 6;
+  Localizer loc(t->map(), t->camera(), o, t->mount());
+  loc.Initialize(std::nullopt);
+  // The initial set covers the area and all headings.
+  double sx = 0, sxx = 0, sc = 0, ss = 0;
+  for (const Particle& p : loc.particles()) {
+    sx += p.base.x;
+    sxx += p.base.x * p.base.x;
+    sc += std::cos(p.base.yaw);
+    ss += std::sin(p.base.yaw);
+  }
+  const double n = loc.particles().size();
+  EXPECT_NEAR(std::sqrt(sxx / n - (sx / n) * (sx / n)), 1.0 / std::sqrt(12.0),
+              0.02);
+  EXPECT_LT(std::hypot(sc, ss) / n, 0.05);  // headings uniform
+  const Drive drive = MakeDrive({0.4, 0.1, 0.5}, 15, 0.03, 2.0 * kDeg, 4);
+  *e = t->Run(drive, &loc, stats);
+  std::printf("global init: errors (m)");
+  for (double x : *e) std::printf(" %.3f", x);
+  std::printf("\nparticles");
+  for (const auto& s : *stats) std::printf(" %d", s.particles);
+  std::printf("\n");
+}
+
+TEST_F(LocalizerTest, PlanarGlobalInitConvergesWithMcl) {
+  std::vector<double> e;
+  std::vector<LocalizerStepStats> stats;
+  GlobalInitCase(this, LocalizationMethod::kMcl, &e, &stats);
+  EXPECT_LT(e.back(), 0.025);
+  EXPECT_LT(Max(std::vector<double>(e.begin() + 10, e.end())), 0.03);
+  // KLD shrinks the set once the filter has converged.
+  EXPECT_LT(stats.back().particles, 1000);
+  EXPECT_EQ(stats.front().particles_weighed, 3000);
+}
+
+TEST_F(LocalizerTest, PlanarGlobalInitConvergesWithMcc) {
+  std::vector<double> e;
+  std::vector<LocalizerStepStats> stats;
+  GlobalInitCase(this, LocalizationMethod::kMcc, &e, &stats);
+  EXPECT_LT(Max(std::vector<double>(e.begin() + 3, e.end())), 0.005);
+  // After convergence, corrected duplicates merge into a handful.
+  EXPECT_LT(stats.back().particles, 50);
+  EXPECT_GT(stats.back().merged, 100);
+}
+
+TEST_F(LocalizerTest, LocalizeSequenceReadsADataset) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() /
+      ("monomap_localizer_test_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  Dataset ds;
+  ds.root = dir;
+  ds.camera = camera_;
+  ds.base_from_cam = mount_;
+  ds.has_groundtruth = true;
+  const Drive drive = MakeDrive({0.0, 0.3, -0.2}, 10, 0.03, 1.0 * kDeg, 5);
+  for (size_t i = 0; i < drive.truth.size(); ++i) {
+    DatasetFrame f;
+    f.timestamp = 0.1 * i;
+    f.image_path = dir / ("f" + std::to_string(i) + ".png");
+    const Rigid3d truth = WorldFromCamOfBase(drive.truth[i], mount_);
+    cv::imwrite(f.image_path.string(),
+                test_scene::LiveImage(renderer_, camera_, truth, 0.9, 5, 2.0,
+                                      i));
+    f.odometry_base = drive.odometry[i];
+    f.odometry_world_from_cam = WorldFromCamOfBase(drive.odometry[i], mount_);
+    f.groundtruth_world_from_cam = truth;
+    ds.frames.push_back(f);
+  }
+  LocalizerOptions o;
+  o.method = LocalizationMethod::kMcc;
+  o.num_particles = 200;
+  o.kld.max_particles = 200;
+  std::vector<TimedPose> trajectory;
+  std::vector<std::vector<Particle>> sets;
+  const LocalizationReport r = LocalizeSequence(map_, ds, o, &trajectory,
+                                                &sets);
+  std::filesystem::remove_all(dir);
+  EXPECT_EQ(r.frames, 10);
+  ASSERT_EQ(trajectory.size(), 10u);
+  EXPECT_EQ(sets.size(), 10u);
+  EXPECT_TRUE(r.has_errors);
+  EXPECT_LT(r.rmse_translation_m, 0.01);
+  EXPECT_LT(r.mean_rotation_error_deg, 0.5);
+  EXPECT_DOUBLE_EQ(r.fraction_within_10cm, 1.0);
+  EXPECT_NEAR(trajectory[3].timestamp, 0.3, 1e-12);
+
+  // The planar state without a camera mount is refused.
+  ds.base_from_cam.reset();
+  EXPECT_THROW(LocalizeSequence(map_, ds, o, &trajectory), InputError);
+}
+
+TEST_F(LocalizerTest, SixDofGlobalInitKeepsHeightAndTilt) {
+  LocalizerOptions o;
+  o.state = LocalizationState::k6Dof;
+  o.num_particles = 400;
+  o.area_min = {-0.5, -1.0};
+  o.area_max = {2.5, 1.0};
+  Localizer loc(map_, camera_, o);
+  // No map trajectory and no reference: height and tilt are unknown.
+  EXPECT_THROW(loc.InitializeGlobal(), StageError);
+  const Rigid3d ref = WorldFromCamOfBase({0.3, 0.1, 0.7}, mount_);
+  loc.InitializeGlobal(ref);
+  ASSERT_EQ(loc.particles().size(), 400u);
+  const Eigen::Vector3d ref_axis = ref.rotation * Eigen::Vector3d::UnitZ();
+  for (const Particle& p : loc.particles()) {
+    EXPECT_NEAR(p.world_from_cam.translation.z(), ref.translation.z(), 1e-12);
+    EXPECT_GE(p.world_from_cam.translation.x(), -0.5);
+    EXPECT_LE(p.world_from_cam.translation.y(), 1.0);
+    // Same pitch: the optical axis keeps its angle to the vertical.
+    const Eigen::Vector3d axis =
+        p.world_from_cam.rotation * Eigen::Vector3d::UnitZ();
+    EXPECT_NEAR(axis.z(), ref_axis.z(), 1e-9);
+  }
+}
+
+TEST(LocalizerOptions, CheckAndParse) {
+  LocalizerOptions o;
+  EXPECT_NO_THROW(o.Check());
+  o.injection_fraction = 1.5;
+  EXPECT_THROW(o.Check(), OptionsError);
+  o = {};
+  o.num_particles = 0;
+  EXPECT_THROW(o.Check(), OptionsError);
+  EXPECT_EQ(ParseLocalizationMethod("mcc"), LocalizationMethod::kMcc);
+  EXPECT_EQ(ParseLocalizationState("6dof"), LocalizationState::k6Dof);
+  EXPECT_EQ(ParseLocalizationInit("global"), LocalizationInit::kGlobal);
+  EXPECT_THROW(ParseLocalizationMethod("ekf"), OptionsError);
+}
+
+}  // namespace
+}  // namespace monomap

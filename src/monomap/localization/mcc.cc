@@ -1,0 +1,206 @@
+#include "monomap/localization/mcc.h"
+
+#include <cmath>
+#include <vector>
+
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core/eigen.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/video/tracking.hpp>
+
+#include "monomap/util/error.h"
+
+namespace monomap {
+
+void MccOptions::Check() const {
+  CheckOption(width >= 16 && height >= 16, "mcc.width/height", "must be >= 16");
+  CheckOption(max_corners >= 4, "mcc.max_corners", "must be >= 4");
+  CheckOption(corner_quality > 0 && corner_quality < 1, "mcc.corner_quality",
+              "must be in (0, 1)");
+  CheckOption(min_corner_distance_px >= 0, "mcc.min_corner_distance_px",
+              "must be >= 0");
+  CheckOption(border_px >= 0, "mcc.border_px", "must be >= 0");
+  CheckOption(klt_window >= 5 && klt_window % 2 == 1, "mcc.klt_window",
+              "must be odd and >= 5");
+  CheckOption(klt_levels >= 0, "mcc.klt_levels", "must be >= 0");
+  CheckOption(max_forward_backward_px > 0, "mcc.max_forward_backward_px",
+              "must be > 0");
+  CheckOption(ransac_threshold_px > 0, "mcc.ransac_threshold_px",
+              "must be > 0");
+  CheckOption(ransac_iterations >= 1, "mcc.ransac_iterations", "must be >= 1");
+  CheckOption(min_inliers >= 6, "mcc.min_inliers", "must be >= 6");
+  CheckOption(max_translation_m > 0, "mcc.max_translation_m", "must be > 0");
+  CheckOption(max_rotation_deg > 0, "mcc.max_rotation_deg", "must be > 0");
+  CheckOption(iterations >= 1, "mcc.iterations", "must be >= 1");
+}
+
+MonteCarloCorrector::MonteCarloCorrector(const Renderer* renderer,
+                                         const Camera& camera,
+                                         const MccOptions& options)
+    : renderer_(renderer), options_(options) {
+  options_.Check();
+  camera.Check();
+  if (renderer_ == nullptr) throw OptionsError("mcc: null renderer");
+  render_camera_ = camera.Pinhole().Scaled(options_.width, options_.height);
+}
+
+namespace {
+
+cv::Mat CvFromRigid(const Rigid3d& cam_from_world, cv::Mat* tvec) {
+  const Eigen::Vector3d w = RotationVectorFromQuaternion(cam_from_world.rotation);
+  cv::Mat rvec = (cv::Mat_<double>(3, 1) << w.x(), w.y(), w.z());
+  *tvec = (cv::Mat_<double>(3, 1) << cam_from_world.translation.x(),
+           cam_from_world.translation.y(), cam_from_world.translation.z());
+  return rvec;
+}
+
+Rigid3d RigidFromCv(const cv::Mat& rvec, const cv::Mat& tvec) {
+  const Eigen::Vector3d w(rvec.at<double>(0), rvec.at<double>(1),
+                          rvec.at<double>(2));
+  const Eigen::Vector3d t(tvec.at<double>(0), tvec.at<double>(1),
+                          tvec.at<double>(2));
+  return Rigid3d(QuaternionFromRotationVector(w), t);
+}
+
+}  // namespace
+
+bool MonteCarloCorrector::Round(const cv::Mat& live_raw, const Rigid3d& start,
+                                Rigid3d* out, MccResult* stats) const {
+  const MccOptions& o = options_;
+  cv::Mat render, depth;
+  renderer_->Render(render_camera_, start, &render, &depth);
+  // Corners only well inside the map's silhouette.
+  cv::Mat mask = depth > 0.0f;
+  if (o.border_px > 0) {
+    cv::erode(mask, mask,
+              cv::getStructuringElement(
+                  cv::MORPH_RECT,
+                  cv::Size(2 * o.border_px + 1, 2 * o.border_px + 1)));
+  }
+  std::vector<cv::Point2f> corners;
+  cv::goodFeaturesToTrack(render, corners, o.max_corners, o.corner_quality,
+                          o.min_corner_distance_px, mask);
+  stats->corners = static_cast<int>(corners.size());
+  stats->tracked = stats->inliers = 0;
+  if (static_cast<int>(corners.size()) < o.min_inliers) return false;
+
+  // KLT assumes brightness constancy: bring the live image to the render's
+  // gain and offset (mean and spread over the map pixels), else exposure
+  // changes bias the tracks by tenths of a pixel.
+  cv::Scalar mr, sr, ml, sl;
+  cv::meanStdDev(render, mr, sr, mask);
+  cv::meanStdDev(live_raw, ml, sl, mask);
+  cv::Mat live;
+  if (sl[0] > 1.0 && sr[0] > 1.0) {
+    const double gain = sr[0] / sl[0];
+    live_raw.convertTo(live, CV_8U, gain, mr[0] - gain * ml[0]);
+  } else {
+    live = live_raw;
+  }
+
+  const cv::Size win(o.klt_window, o.klt_window);
+  const cv::TermCriteria term(cv::TermCriteria::COUNT | cv::TermCriteria::EPS,
+                              30, 0.01);
+  std::vector<cv::Point2f> fwd, back;
+  std::vector<uchar> st_f, st_b;
+  std::vector<float> err;
+  cv::calcOpticalFlowPyrLK(render, live, corners, fwd, st_f, err, win,
+                           o.klt_levels, term);
+  back = corners;  // backward starts at the original corner positions
+  cv::calcOpticalFlowPyrLK(live, render, fwd, back, st_b, err, win,
+                           o.klt_levels, term, cv::OPTFLOW_USE_INITIAL_FLOW);
+
+  const Camera& c = render_camera_;
+  std::vector<cv::Point3d> object;
+  std::vector<cv::Point2d> image;
+  for (size_t i = 0; i < corners.size(); ++i) {
+    if (!st_f[i] || !st_b[i]) continue;
+    const cv::Point2f d = back[i] - corners[i];
+    if (d.dot(d) > o.max_forward_backward_px * o.max_forward_backward_px)
+      continue;
+    const int u = cvRound(corners[i].x), v = cvRound(corners[i].y);
+    if (u < 0 || v < 0 || u >= depth.cols || v >= depth.rows) continue;
+    const float z = depth.at<float>(v, u);
+    if (!(z > 0.0f)) continue;
+    // Back-project the corner (exact at the pixel centre it was found on).
+    const Eigen::Vector3d x_cam((corners[i].x - c.cx) / c.fx * z,
+                                (corners[i].y - c.cy) / c.fy * z, z);
+    const Eigen::Vector3d x = start * x_cam;
+    object.emplace_back(x.x(), x.y(), x.z());
+    image.emplace_back(fwd[i].x, fwd[i].y);
+  }
+  stats->tracked = static_cast<int>(object.size());
+  if (stats->tracked < o.min_inliers) return false;
+
+  const cv::Mat k = (cv::Mat_<double>(3, 3) << c.fx, 0, c.cx, 0, c.fy, c.cy,
+                     0, 0, 1);
+  cv::Mat tvec;
+  cv::Mat rvec = CvFromRigid(start.Inverse(), &tvec);
+  std::vector<int> inliers;
+  const bool ok = cv::solvePnPRansac(
+      object, image, k, cv::noArray(), rvec, tvec, /*useExtrinsicGuess=*/true,
+      o.ransac_iterations, static_cast<float>(o.ransac_threshold_px), 0.999,
+      inliers, cv::SOLVEPNP_ITERATIVE);
+  if (!ok || static_cast<int>(inliers.size()) < o.min_inliers) {
+    stats->inliers = static_cast<int>(inliers.size());
+    return false;
+  }
+  std::vector<cv::Point3d> in_obj;
+  std::vector<cv::Point2d> in_img;
+  for (int i : inliers) {
+    in_obj.push_back(object[i]);
+    in_img.push_back(image[i]);
+  }
+  cv::solvePnPRefineLM(in_obj, in_img, k, cv::noArray(), rvec, tvec);
+  std::vector<cv::Point2d> proj;
+  cv::projectPoints(in_obj, rvec, tvec, k, cv::noArray(), proj);
+  double sum_sq = 0.0;
+  for (size_t i = 0; i < proj.size(); ++i) {
+    const cv::Point2d d = proj[i] - in_img[i];
+    sum_sq += d.dot(d);
+  }
+  stats->inliers = static_cast<int>(inliers.size());
+  stats->rms_reprojection_px = std::sqrt(sum_sq / proj.size());
+  *out = RigidFromCv(rvec, tvec).Inverse();
+  return true;
+}
+
+MccResult MonteCarloCorrector::Correct(const cv::Mat& live,
+                                       const Rigid3d& world_from_cam) const {
+  if (live.cols != options_.width || live.rows != options_.height ||
+      live.type() != CV_8UC1) {
+    throw InputError("mcc: live image must be 8-bit grey " +
+                     std::to_string(options_.width) + "x" +
+                     std::to_string(options_.height));
+  }
+  MccResult r;
+  Rigid3d pose = world_from_cam;
+  bool any = false;
+  for (int it = 0; it < options_.iterations; ++it) {
+    Rigid3d next;
+    MccResult round_stats;
+    if (!Round(live, pose, &next, &round_stats)) {
+      if (!any) r = round_stats;  // report why the first round failed
+      break;
+    }
+    r = round_stats;
+    pose = next;
+    any = true;
+  }
+  r.world_from_cam = world_from_cam;
+  r.accepted = false;
+  if (!any) return r;
+  r.translation_change_m =
+      (pose.translation - world_from_cam.translation).norm();
+  r.rotation_change_deg =
+      AngleBetween(pose.rotation, world_from_cam.rotation) * 180.0 / M_PI;
+  if (r.translation_change_m > options_.max_translation_m ||
+      r.rotation_change_deg > options_.max_rotation_deg) {
+    return r;
+  }
+  r.accepted = true;
+  r.world_from_cam = pose;
+  return r;
+}
+
+}  // namespace monomap

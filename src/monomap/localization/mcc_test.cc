@@ -1,0 +1,68 @@
+#include "monomap/localization/mcc.h"
+
+#include <cmath>
+#include <cstdio>
+
+#include <gtest/gtest.h>
+
+#include "monomap/localization/measurement_model.h"
+#include "monomap/localization/particle_filter.h"
+#include "monomap/localization/test_scene.h"
+
+namespace monomap {
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+TEST(Mcc, CorrectsAnOffsetParticle) {
+  const Map map = test_scene::RoomMap();
+  const Renderer renderer(map);
+  const Camera camera = test_scene::LiveCamera();
+  const MonteCarloCorrector mcc(&renderer, camera);
+  const LiveImagePreparer prep(camera);
+  const Rigid3d mount = test_scene::BaseFromCam();
+  int n = 0;
+  for (const Pose2d& base : {Pose2d{0.3, 0.2, 0.3}, Pose2d{1.2, -0.5, -0.8},
+                             Pose2d{0.5, 0.6, 2.5}}) {
+    const Rigid3d truth = WorldFromCamOfBase(base, mount);
+    const cv::Mat raw =
+        test_scene::LiveImage(renderer, camera, truth, 0.8, 15, 2.0, ++n);
+    const cv::Mat live = LiveImagePreparer::Downscale(prep.Undistort(raw),
+                                                      mcc.options().width,
+                                                      mcc.options().height);
+    // Offset (2 cm, -1 cm) in the world and 1 degree about the camera's
+    // vertical axis.
+    const Rigid3d offset(
+        QuaternionFromRotationVector({0, 1 * kDeg, 0}) * truth.rotation,
+        truth.translation + Eigen::Vector3d(0.02, -0.01, 0));
+    const MccResult r = mcc.Correct(live, offset);
+    ASSERT_TRUE(r.accepted) << "inliers " << r.inliers << " tracked "
+                            << r.tracked << " corners " << r.corners;
+    const double et = (r.world_from_cam.translation - truth.translation).norm();
+    const double er =
+        AngleBetween(r.world_from_cam.rotation, truth.rotation) / kDeg;
+    std::printf("pose %d: error %.2f mm %.3f deg, inliers %d/%d, rms %.2f px\n",
+                n, et * 1e3, er, r.inliers, r.tracked, r.rms_reprojection_px);
+    EXPECT_LT(et, 0.003) << "pose " << n;
+    EXPECT_LT(er, 0.2) << "pose " << n;
+    EXPECT_GE(r.inliers, 30);
+    EXPECT_LT(r.rms_reprojection_px, 0.2);
+    EXPECT_NEAR(r.translation_change_m, std::sqrt(0.0005), 0.005);
+  }
+}
+
+TEST(Mcc, RefusesWithoutMap) {
+  const Map map = test_scene::RoomMap();
+  const Renderer renderer(map);
+  const MonteCarloCorrector mcc(&renderer, test_scene::LiveCamera());
+  const cv::Mat live(120, 160, CV_8UC1, cv::Scalar(90));
+  // Looking up from above the walls: nothing rendered, nothing corrected.
+  const Rigid3d up(QuaternionFromRotationVector({M_PI / 2, 0, 0}),
+                   Eigen::Vector3d(0, 0, 2.0));
+  const MccResult r = mcc.Correct(live, up);
+  EXPECT_FALSE(r.accepted);
+  EXPECT_EQ(r.corners, 0);
+}
+
+}  // namespace
+}  // namespace monomap
