@@ -18,6 +18,9 @@ function(monomap_test)
   endif()
   add_executable(${ARG_NAME} ${ARG_SRCS})
   target_link_libraries(${ARG_NAME} PRIVATE ${ARG_DEPS} GTest::gtest GTest::gtest_main)
+  # Cases of one executable share fixture directories under /tmp, so they
+  # never run concurrently (RESOURCE_LOCK); executables run in parallel.
   gtest_discover_tests(${ARG_NAME} DISCOVERY_TIMEOUT 60
-                       PROPERTIES ENVIRONMENT "MONOMAP_SOURCE_DIR=${PROJECT_SOURCE_DIR}")
+                       PROPERTIES ENVIRONMENT "MONOMAP_SOURCE_DIR=${PROJECT_SOURCE_DIR}"
+                                  RESOURCE_LOCK ${ARG_NAME})
 endfunction()

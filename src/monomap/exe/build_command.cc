@@ -1,0 +1,77 @@
+// monomap build DATASET -o MAP_DIR [--report REPORT.json]
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+
+#include "monomap/exe/commands.h"
+#include "monomap/io/dataset.h"
+#include "monomap/pipelines/mapping_pipeline.h"
+#include "monomap/util/file.h"
+
+namespace monomap {
+
+void RegisterBuildCommand(CLI::App& app) {
+  struct Args {
+    std::string dataset;
+    std::string output;
+    std::string report;
+    int first_frame = 0;
+    int num_frames = -1;
+    bool no_bundle_adjustment = false;
+    bool points_only = false;
+    int ransac_iterations = 2000;
+    bool quiet = false;
+  };
+  auto args = std::make_shared<Args>();
+  CLI::App* cmd = app.add_subcommand(
+      "build", "Build a map (points, planes, textures) from a dataset");
+  cmd->add_option("dataset", args->dataset, "Dataset directory")
+      ->required();
+  cmd->add_option("-o,--output", args->output, "Map directory to write")
+      ->required();
+  cmd->add_option("--report", args->report,
+                  "Write counts and per-stage timings as JSON");
+  cmd->add_option("--first-frame", args->first_frame,
+                  "Index of the first frame to use");
+  cmd->add_option("--frames", args->num_frames,
+                  "Number of frames to use (default: all)");
+  cmd->add_flag("--no-ba", args->no_bundle_adjustment,
+                "Skip bundle adjustment (keep odometry poses)");
+  cmd->add_flag("--points-only", args->points_only,
+                "Stop after triangulation and bundle adjustment");
+  cmd->add_option("--ransac-iterations", args->ransac_iterations,
+                  "RANSAC hypotheses per plane");
+  cmd->add_flag("-q,--quiet", args->quiet, "No progress output");
+  cmd->callback([args]() {
+    DatasetOptions dataset_options;
+    dataset_options.first_frame = args->first_frame;
+    dataset_options.num_frames = args->num_frames;
+    // Ground truth is never used to build maps.
+    dataset_options.load_groundtruth = false;
+    const Dataset dataset = LoadDataset(args->dataset, dataset_options);
+
+    MappingOptions options;
+    options.bundle_adjustment.enabled = !args->no_bundle_adjustment;
+    options.points_only = args->points_only;
+    options.planes.ransac_iterations = args->ransac_iterations;
+    options.show_progress = !args->quiet;
+    const MappingResult result = BuildMap(dataset, options);
+    WriteMappingResult(args->output, result);
+    const nlohmann::json report = result.report.ToJson();
+    if (!args->report.empty()) {
+      WriteFileAtomic(args->report, report.dump(2) + "\n");
+    }
+    if (!args->quiet) {
+      std::fprintf(stderr,
+                   "monomap: %d frames, %zu tracks, %zu points, %zu planes "
+                   "in %.2f s (%.1f frames/s) -> %s\n",
+                   result.report.num_frames, result.tracks.size(),
+                   result.map.landmarks.size(), result.map.planes.size(),
+                   result.report.total_seconds,
+                   result.report.num_frames / result.report.total_seconds,
+                   args->output.c_str());
+    }
+  });
+}
+
+}  // namespace monomap

@@ -1,0 +1,15 @@
+// The `monomap` binary: one subcommand per file. Each Register* function
+// adds its subcommand and sets a callback that throws monomap::Error on
+// failure; main() turns errors into messages and exit codes.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+namespace monomap {
+
+void RegisterBuildCommand(CLI::App& app);
+void RegisterEvalCommand(CLI::App& app);
+void RegisterSimulateCommand(CLI::App& app);
+void RegisterDemoCommand(CLI::App& app);
+
+}  // namespace monomap

@@ -1,0 +1,146 @@
+// monomap eval points MAP_DIR (--plane STRUCTURE.yaml | --surface CLOUD.ply)
+// monomap eval trajectory ESTIMATE.txt GROUNDTRUTH.txt [--align ...]
+#include <cstdio>
+#include <iostream>
+#include <memory>
+
+#include "monomap/eval/point_accuracy.h"
+#include "monomap/eval/report_json.h"
+#include "monomap/eval/trajectory_metrics.h"
+#include "monomap/exe/commands.h"
+#include "monomap/io/map_format.h"
+#include "monomap/io/ply.h"
+#include "monomap/io/trajectory_io.h"
+#include "monomap/util/error.h"
+#include "monomap/util/file.h"
+
+namespace monomap {
+
+namespace {
+
+// Distance from each point to the nearest camera centre of the trajectory
+// (the "distance to the camera" that relative errors divide by).
+std::vector<double> DistanceToTrajectory(
+    const std::vector<Eigen::Vector3d>& points,
+    const std::vector<TimedPose>& trajectory) {
+  std::vector<double> d(points.size(),
+                        std::numeric_limits<double>::infinity());
+  for (size_t i = 0; i < points.size(); ++i) {
+    for (const auto& p : trajectory) {
+      d[i] = std::min(d[i], (points[i] - p.world_from_cam.translation).norm());
+    }
+  }
+  return d;
+}
+
+void PrintOrWrite(const nlohmann::json& j, const std::string& table,
+                  const std::string& json_path) {
+  std::cout << table;
+  if (!json_path.empty()) WriteFileAtomic(json_path, j.dump(2) + "\n");
+}
+
+}  // namespace
+
+void RegisterEvalCommand(CLI::App& app) {
+  CLI::App* eval = app.add_subcommand("eval", "Accuracy figures");
+  eval->require_subcommand(1);
+
+  struct PointArgs {
+    std::string map_dir, plane_yaml, surface_ply, json;
+    int plane_label = -2;  // -2: all points, -1: points on no plane
+    bool largest_plane = false;
+  };
+  auto pa = std::make_shared<PointArgs>();
+  CLI::App* points = eval->add_subcommand(
+      "points", "Point error against a ground-truth plane or surface cloud");
+  points->add_option("map", pa->map_dir, "Map directory")->required();
+  auto* plane_opt = points->add_option(
+      "--plane", pa->plane_yaml, "Ground-truth structure YAML (plane)");
+  auto* surface_opt = points->add_option("--surface", pa->surface_ply,
+                                         "Ground-truth surface PLY");
+  plane_opt->excludes(surface_opt);
+  points->add_option("--plane-label", pa->plane_label,
+                     "Evaluate only points with this plane label");
+  points->add_flag("--largest-plane", pa->largest_plane,
+                   "Evaluate only points of the plane with most points");
+  points->add_option("--json", pa->json, "Write the figures as JSON");
+  points->callback([pa]() {
+    if (pa->plane_yaml.empty() == pa->surface_ply.empty()) {
+      throw OptionsError("eval points: give exactly one of --plane or "
+                         "--surface");
+    }
+    const Map map = ReadMap(pa->map_dir);
+    int label = pa->plane_label;
+    if (pa->largest_plane) {
+      std::map<int, int> counts;
+      for (const auto& l : map.landmarks) {
+        if (l.plane_id >= 0) ++counts[l.plane_id];
+      }
+      if (counts.empty()) {
+        throw StageError(pa->map_dir + ": map has no plane labels");
+      }
+      label = std::max_element(counts.begin(), counts.end(),
+                               [](auto& a, auto& b) {
+                                 return a.second < b.second;
+                               })->first;
+    }
+    std::vector<Eigen::Vector3d> xs;
+    for (const auto& l : map.landmarks) {
+      if (label == -2 || l.plane_id == label) xs.push_back(l.x_in_world);
+    }
+    if (xs.empty()) throw StageError("no points to evaluate");
+    const auto dist = DistanceToTrajectory(xs, map.trajectory);
+    PointAccuracy acc;
+    if (!pa->plane_yaml.empty()) {
+      acc = EvaluatePointsAgainstPlane(xs, dist,
+                                       ReadGroundTruthPlaneYaml(pa->plane_yaml));
+    } else {
+      const NearestNeighborIndex index(ReadPlyPoints(pa->surface_ply));
+      acc = EvaluatePointsAgainstCloud(xs, dist, index);
+    }
+    nlohmann::json j = ToJson(acc);
+    j["plane_label"] = label;
+    PrintOrWrite(j, FormatTable(acc), pa->json);
+  });
+
+  struct TrajArgs {
+    std::string estimate, groundtruth, align = "se3", json;
+    int delta = 1;
+  };
+  auto ta = std::make_shared<TrajArgs>();
+  CLI::App* traj = eval->add_subcommand(
+      "trajectory", "Absolute and relative pose error of a TUM trajectory");
+  traj->add_option("estimate", ta->estimate, "Estimated trajectory (TUM)")
+      ->required();
+  traj->add_option("groundtruth", ta->groundtruth,
+                   "Ground-truth trajectory (TUM)")
+      ->required();
+  traj->add_option("--align", ta->align, "none | first | se3 | sim3")
+      ->check(CLI::IsMember({"none", "first", "se3", "sim3"}));
+  traj->add_option("--delta", ta->delta, "Frame delta of the relative error");
+  traj->add_option("--json", ta->json, "Write the figures as JSON");
+  traj->callback([ta]() {
+    const auto est = ReadTumTrajectory(ta->estimate);
+    const auto gt = ReadTumTrajectory(ta->groundtruth);
+    const Alignment alignment =
+        ta->align == "none"    ? Alignment::kNone
+        : ta->align == "first" ? Alignment::kFirstPose
+        : ta->align == "se3"   ? Alignment::kSE3
+                               : Alignment::kSim3;
+    const TrajectoryErrors ate =
+        AbsoluteTrajectoryError(est, gt, alignment, 1e-3);
+    const TrajectoryErrors rpe = RelativePoseError(est, gt, ta->delta, 1e-3);
+    nlohmann::json j;
+    j["alignment"] = ta->align;
+    j["ate"] = ToJson(ate);
+    j["rpe"] = ToJson(rpe);
+    j["rpe"]["delta_frames"] = ta->delta;
+    PrintOrWrite(j,
+                 "absolute trajectory error (" + ta->align + ")\n" +
+                     FormatTable(ate) + "relative pose error (delta " +
+                     std::to_string(ta->delta) + ")\n" + FormatTable(rpe),
+                 ta->json);
+  });
+}
+
+}  // namespace monomap

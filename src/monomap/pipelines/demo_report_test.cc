@@ -1,0 +1,85 @@
+#include "monomap/pipelines/demo_report.h"
+
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "monomap/util/error.h"
+#include "monomap/util/file.h"
+
+namespace monomap {
+namespace {
+
+size_t CountOccurrences(const std::string& text, const std::string& what) {
+  size_t n = 0;
+  for (size_t pos = text.find(what); pos != std::string::npos;
+       pos = text.find(what, pos + what.size())) {
+    ++n;
+  }
+  return n;
+}
+
+TEST(DemoOptionsTest, RejectsBadValues) {
+  DemoOptions o;
+  EXPECT_NO_THROW(o.Check());
+  o.world = "moon";
+  EXPECT_THROW(o.Check(), OptionsError);
+  o = DemoOptions();
+  o.num_frames = 5;
+  EXPECT_THROW(o.Check(), OptionsError);
+  o = DemoOptions();
+  o.max_match_angle_deg = 0;
+  EXPECT_THROW(o.Check(), OptionsError);
+}
+
+// A small demo end to end: the report is written, self-contained, and its
+// figures say the map is close to the ground truth.
+TEST(DemoReportTest, SmallHallwayDemo) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() /
+      ("monomap_demo_test_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  DemoOptions o;
+  o.output_dir = dir;
+  o.num_frames = 60;
+  o.width = 320;
+  o.height = 240;
+  o.show_progress = false;
+  const DemoReport r = RunDemo(o);
+
+  EXPECT_EQ(r.frames, 60);
+  EXPECT_GT(r.landmarks, 200);
+  EXPECT_GE(r.fitted_planes, 1);
+  EXPECT_GE(r.observed_true_planes, 1);
+  EXPECT_GT(r.plane_recall, 0.0);
+  EXPECT_GE(r.plane_precision, 0.5);
+  // Points on fitted planes lie on the true structure within centimetres.
+  EXPECT_GT(r.point_error_on_planes.absolute_m.count, 100u);
+  EXPECT_LT(r.point_error_on_planes.absolute_m.median, 0.03);
+  EXPECT_LT(r.point_error_on_planes.relative_percent.median, 3.0);
+  // The refined trajectory is at least as good as odometry (small slack).
+  EXPECT_EQ(r.ate_refined.matched, 60u);
+  EXPECT_LT(r.ate_refined.translation_m.rms, 0.05);
+  EXPECT_LE(r.ate_refined.translation_m.rms,
+            r.ate_odometry.translation_m.rms + 0.005);
+
+  ASSERT_TRUE(std::filesystem::exists(r.report_json));
+  ASSERT_TRUE(std::filesystem::exists(dir / "map" / "map.json"));
+  const std::string html = ReadFileToString(r.report_html);
+  // 3 track frames, 3 real + 3 rendered views, one texture per plane.
+  EXPECT_EQ(CountOccurrences(html, "<img "),
+            static_cast<size_t>(9 + r.fitted_planes));
+  EXPECT_EQ(CountOccurrences(html, "src=\"data:image/png;base64,"),
+            static_cast<size_t>(9 + r.fitted_planes));
+  EXPECT_EQ(CountOccurrences(html, "src=\"http"), 0u);
+  EXPECT_EQ(CountOccurrences(html, "href=\"http"), 0u);
+  EXPECT_GE(CountOccurrences(html, "<svg "), 4u);
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace monomap

@@ -1,0 +1,267 @@
+#include "monomap/pipelines/mapping_pipeline.h"
+
+#include <algorithm>
+#include <mutex>
+#include <opencv2/imgproc.hpp>
+#include <unordered_map>
+
+#include "monomap/io/feature_table.h"
+#include "monomap/io/map_format.h"
+#include "monomap/util/error.h"
+#include "monomap/util/file.h"
+#include "monomap/util/progress.h"
+
+namespace monomap {
+
+void MappingOptions::Check() const {
+  tracking.Check();
+  triangulation.Check();
+  bundle_adjustment.Check();
+  planes.Check();
+  homographies.Check();
+  mosaic.Check();
+  CheckOption(first_pass_error_factor >= 1.0, "mapping.first_pass_error_factor",
+              "must be >= 1");
+}
+
+namespace {
+
+// Keeps a small colour thumbnail of every frame while tracking decodes it,
+// so landmark colours need no second pass over the images.
+class ThumbnailCache {
+ public:
+  static constexpr int kScale = 4;
+  explicit ThumbnailCache(size_t frames) : thumbs_(frames) {}
+  void Store(int frame, const cv::Mat& image) {
+    cv::Mat small;
+    cv::resize(image, small, cv::Size(), 1.0 / kScale, 1.0 / kScale,
+               cv::INTER_AREA);
+    if (small.channels() == 1) cv::cvtColor(small, small, cv::COLOR_GRAY2BGR);
+    thumbs_[frame] = small;
+  }
+  Eigen::Vector3f ColorAt(int frame, const Eigen::Vector2d& px) const {
+    const cv::Mat& t = thumbs_[frame];
+    if (t.empty()) return Eigen::Vector3f::Zero();
+    const int c = std::clamp(static_cast<int>((px.x() + 0.5) / kScale), 0,
+                             t.cols - 1);
+    const int r = std::clamp(static_cast<int>((px.y() + 0.5) / kScale), 0,
+                             t.rows - 1);
+    const cv::Vec3b bgr = t.at<cv::Vec3b>(r, c);
+    return Eigen::Vector3f(bgr[2], bgr[1], bgr[0]);
+  }
+
+ private:
+  std::vector<cv::Mat> thumbs_;
+};
+
+}  // namespace
+
+MappingResult BuildMap(const Dataset& dataset, const MappingOptions& options) {
+  options.Check();
+  Timer total;
+  MappingResult result;
+  MappingReport& report = result.report;
+  const int num_frames = static_cast<int>(dataset.frames.size());
+  report.num_frames = num_frames;
+  if (num_frames < 2) {
+    throw StageError("need at least 2 frames to build a map, got " +
+                     std::to_string(num_frames));
+  }
+  const Camera& camera = dataset.camera;
+  camera.Check();
+
+  // Stage 1: tracking (decoding overlaps tracking inside TrackFeatures).
+  Timer timer;
+  ThumbnailCache thumbs(num_frames);
+  {
+    ProgressBar progress("tracking", num_frames, options.show_progress);
+    auto load = [&](int frame) {
+      cv::Mat color = dataset.LoadImage(frame, /*color=*/true);
+      thumbs.Store(frame, color);
+      cv::Mat grey;
+      cv::cvtColor(color, grey, cv::COLOR_BGR2GRAY);
+      progress.Advance();
+      return grey;
+    };
+    report.tracking =
+        TrackFeatures(load, num_frames, options.tracking, &result.tracks);
+  }
+  report.timings.push_back({"tracking", timer.ElapsedSeconds()});
+  if (result.tracks.empty()) {
+    throw StageError("tracking found no features in " +
+                     dataset.root.string());
+  }
+
+  // Stage 2: triangulation with odometry poses, then bundle adjustment.
+  timer.Restart();
+  std::vector<Rigid3d> world_from_cam;
+  world_from_cam.reserve(num_frames);
+  for (const auto& f : dataset.frames) {
+    world_from_cam.push_back(f.odometry_world_from_cam);
+  }
+  result.odometry_world_from_cam = world_from_cam;
+  std::vector<Landmark>& landmarks = result.map.landmarks;
+  // With drifting odometry poses a strict reprojection test would reject
+  // good tracks, so the first pass is loose: bundle adjustment (robust
+  // loss) then corrects the poses, and every track is triangulated again
+  // against the corrected poses with the strict thresholds.
+  TriangulationOptions loose = options.triangulation;
+  if (options.bundle_adjustment.enabled) {
+    loose.max_reprojection_error_px *= options.first_pass_error_factor;
+    loose.max_observation_error_px *= options.first_pass_error_factor;
+  }
+  report.triangulation =
+      TriangulateTracks(camera, world_from_cam, result.tracks, loose,
+                        &landmarks);
+  report.timings.push_back({"triangulation", timer.ElapsedSeconds()});
+  if (landmarks.empty()) {
+    throw StageError("no track could be triangulated (too little motion or "
+                     "too few features?)");
+  }
+  timer.Restart();
+  if (options.bundle_adjustment.enabled) {
+    BundleAdjustmentOptions ba = options.bundle_adjustment;
+    // The loose first pass carries outliers: the joint solve sees them
+    // through the robust loss; dropping uses the loose threshold too.
+    ba.max_reprojection_error_px = loose.max_reprojection_error_px;
+    report.bundle_adjustment =
+        BundleAdjust(camera, result.tracks, ba, &world_from_cam, &landmarks);
+    report.timings.push_back({"bundle_adjustment", timer.ElapsedSeconds()});
+    timer.Restart();
+    report.retriangulation =
+        TriangulateTracks(camera, world_from_cam, result.tracks,
+                          options.triangulation, &landmarks);
+    report.timings.push_back({"retriangulation", timer.ElapsedSeconds()});
+  }
+
+  // Landmark colours from the frame in the middle of each track.
+  {
+    std::unordered_map<FeatureId, const Track*> track_by_id;
+    for (const auto& t : result.tracks) track_by_id[t.id] = &t;
+    for (auto& l : landmarks) {
+      const auto it = track_by_id.find(l.id);
+      if (it == track_by_id.end() || it->second->observations.empty()) continue;
+      const auto& obs = it->second->observations;
+      const Observation& o = obs[obs.size() / 2];
+      l.color = thumbs.ColorAt(o.frame, o.px);
+    }
+  }
+
+  result.map.camera = camera;
+  result.map.trajectory.reserve(num_frames);
+  for (int i = 0; i < num_frames; ++i) {
+    result.map.trajectory.push_back(
+        {dataset.frames[i].timestamp, world_from_cam[i]});
+  }
+
+  if (!options.points_only) {
+    // Stage 3: planes.
+    timer.Restart();
+    std::vector<Eigen::Vector3d> centers;
+    for (const auto& p : world_from_cam) centers.push_back(p.translation);
+    report.planes =
+        FitPlanes(options.planes, &landmarks, &result.segments, &centers);
+    report.timings.push_back({"planes", timer.ElapsedSeconds()});
+
+    // Stages 4 and 5: homographies and mosaics.
+    auto load_image = [&](int frame) { return dataset.LoadImage(frame, true); };
+    timer.Restart();
+    std::vector<ImagePlaneHomography> homographies;
+    report.homographies = ComputeImagePlaneHomographies(
+        camera, world_from_cam, result.segments, landmarks, result.tracks,
+        options.homographies, &homographies);
+    report.timings.push_back({"homographies", timer.ElapsedSeconds()});
+    timer.Restart();
+    report.mosaic = BuildTexturedPlanes(
+        camera, world_from_cam, result.segments, landmarks, result.tracks,
+        homographies, load_image, options.mosaic, &result.map.planes);
+    report.timings.push_back({"mosaic", timer.ElapsedSeconds()});
+  }
+  report.total_seconds = total.ElapsedSeconds();
+  return result;
+}
+
+nlohmann::json MappingReport::ToJson() const {
+  nlohmann::json j;
+  j["num_frames"] = num_frames;
+  j["tracking"] = {
+      {"tracks", tracking.tracks_returned},
+      {"tracks_created", tracking.tracks_created},
+      {"mean_track_length", tracking.mean_track_length},
+      {"mean_features_per_frame", tracking.mean_features_per_frame},
+      {"seconds", tracking.seconds}};
+  j["triangulation"] = {
+      {"tracks_in", triangulation.num_tracks},
+      {"points", triangulation.num_points},
+      {"rejected_short", triangulation.rejected_short},
+      {"rejected_failed", triangulation.rejected_failed},
+      {"rejected_angle", triangulation.rejected_angle},
+      {"rejected_reprojection", triangulation.rejected_reprojection},
+      {"rejected_cheirality", triangulation.rejected_cheirality},
+      {"mean_reprojection_error_px", triangulation.mean_reprojection_error_px},
+      {"median_reprojection_error_px",
+       triangulation.median_reprojection_error_px}};
+  j["retriangulation"] = {
+      {"points", retriangulation.num_points},
+      {"rejected_reprojection", retriangulation.rejected_reprojection},
+      {"rejected_angle", retriangulation.rejected_angle},
+      {"mean_reprojection_error_px",
+       retriangulation.mean_reprojection_error_px}};
+  j["bundle_adjustment"] = {
+      {"termination", bundle_adjustment.termination},
+      {"poses", bundle_adjustment.num_poses},
+      {"points_joint", bundle_adjustment.num_points_joint},
+      {"initial_rms_reprojection_error_px",
+       bundle_adjustment.initial_rms_error_px},
+      {"final_rms_reprojection_error_px",
+       bundle_adjustment.final_rms_error_px},
+      {"initial_median_reprojection_error_px",
+       bundle_adjustment.initial_median_error_px},
+      {"final_median_reprojection_error_px",
+       bundle_adjustment.final_median_error_px},
+      {"iterations", bundle_adjustment.iterations},
+      {"points_dropped", bundle_adjustment.num_dropped},
+      {"mean_pose_change_m", bundle_adjustment.mean_pose_change_m},
+      {"mean_pose_change_deg", bundle_adjustment.mean_pose_change_deg}};
+  nlohmann::json planes_json = {{"planes", planes.num_planes},
+                                {"outliers", planes.num_outliers},
+                                {"inliers_per_plane", planes.inliers_per_plane}};
+  j["planes"] = planes_json;
+  j["homographies"] = {
+      {"count", homographies.num_homographies},
+      {"checked", homographies.num_checked},
+      {"refined", homographies.num_refined},
+      {"median_residual_before_px", homographies.median_residual_before_px},
+      {"median_residual_after_px", homographies.median_residual_after_px}};
+  nlohmann::json mosaics = nlohmann::json::array();
+  for (const auto& m : mosaic.planes) {
+    mosaics.push_back({{"plane_id", m.plane_id},
+                       {"pixels_per_meter", m.pixels_per_meter},
+                       {"width", m.width},
+                       {"height", m.height},
+                       {"frames", m.frames},
+                       {"coverage", m.coverage},
+                       {"features", m.num_features},
+                       {"feature_residual_median_px",
+                        m.feature_residual_median_px},
+                       {"feature_residual_max_px", m.feature_residual_max_px}});
+  }
+  j["mosaics"] = mosaics;
+  nlohmann::json t = nlohmann::json::object();
+  for (const auto& s : timings) t[s.name] = s.seconds;
+  j["timings_seconds"] = t;
+  j["total_seconds"] = total_seconds;
+  j["frames_per_second"] =
+      total_seconds > 0 ? num_frames / total_seconds : 0.0;
+  return j;
+}
+
+void WriteMappingResult(const std::filesystem::path& dir,
+                        const MappingResult& result) {
+  AtomicDirectory out(dir);
+  WriteMap(out.path(), result.map);
+  WriteFeatureTable(out.path() / "features.csv", result.tracks);
+  out.Commit();
+}
+
+}  // namespace monomap

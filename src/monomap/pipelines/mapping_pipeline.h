@@ -1,0 +1,88 @@
+// MappingPipeline: dataset in, map out. Runs the stages in order (track,
+// triangulate, bundle-adjust, fit planes, homographies, mosaics) and
+// collects their reports and timings.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "monomap/io/dataset.h"
+#include "monomap/map/map.h"
+#include "monomap/planes/plane_fitting.h"
+#include "monomap/texture/image_plane_homography.h"
+#include "monomap/texture/mosaic.h"
+#include "monomap/tracking/klt_tracker.h"
+#include "monomap/triangulation/bundle_adjustment.h"
+#include "monomap/triangulation/triangulator.h"
+
+namespace monomap {
+
+struct MappingOptions {
+  // Stage 1: KLT tracking.
+  KltTrackerOptions tracking;
+  // Stage 2: triangulation of tracks with odometry poses.
+  TriangulationOptions triangulation;
+  // Stage 2b: bundle adjustment with odometry priors (enabled by default).
+  BundleAdjustmentOptions bundle_adjustment;
+  // Stage 3: RANSAC planes.
+  PlaneFittingOptions planes;
+  // Stage 4: image-to-plane homographies.
+  HomographyOptions homographies;
+  // Stage 5: texture mosaics.
+  MosaicOptions mosaic;
+  // The first triangulation (against odometry poses, before bundle
+  // adjustment) accepts reprojection errors this many times larger.
+  double first_pass_error_factor = 4.0;
+  // Stop after triangulation + bundle adjustment (a point map only).
+  bool points_only = false;
+  // Draw progress bars on stderr (only when it is a terminal).
+  bool show_progress = true;
+
+  void Check() const;
+};
+
+// Wall-clock seconds of one stage.
+struct StageTiming {
+  std::string name;
+  double seconds = 0.0;
+};
+
+struct MappingReport {
+  int num_frames = 0;
+  TrackingReport tracking;
+  TriangulationReport triangulation;
+  BundleAdjustmentReport bundle_adjustment;
+  // Triangulation against the adjusted poses (strict thresholds).
+  TriangulationReport retriangulation;
+  PlaneFittingReport planes;
+  HomographyReport homographies;
+  MosaicReport mosaic;
+  std::vector<StageTiming> timings;
+  double total_seconds = 0.0;
+
+  nlohmann::json ToJson() const;
+};
+
+struct MappingResult {
+  Map map;
+  std::vector<Track> tracks;
+  std::vector<PlaneSegment> segments;
+  // Odometry poses the map was built from (world_from_cam per frame).
+  std::vector<Rigid3d> odometry_world_from_cam;
+  MappingReport report;
+};
+
+// Builds the map. Throws InputError on bad data, StageError if a stage
+// cannot produce anything (e.g. no features).
+MappingResult BuildMap(const Dataset& dataset, const MappingOptions& options);
+
+// Writes the map directory atomically: the directory appears complete or
+// not at all (an existing one is replaced only on success). Also writes
+// the feature table (features.csv).
+void WriteMappingResult(const std::filesystem::path& dir,
+                        const MappingResult& result);
+
+}  // namespace monomap

@@ -1,0 +1,123 @@
+// The `monomap` binary: exit codes, error messages and atomic output.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "monomap/io/map_format.h"
+#include "monomap/sim/simulate.h"
+
+namespace monomap {
+namespace {
+namespace fs = std::filesystem;
+
+struct RunResult {
+  int exit_code = -1;
+  std::string output;  // stdout + stderr
+};
+
+RunResult RunMonomap(const std::string& args) {
+  const std::string cmd = std::string(MONOMAP_BINARY) + " " + args + " 2>&1";
+  RunResult r;
+  FILE* pipe = popen(cmd.c_str(), "r");
+  if (!pipe) return r;
+  std::array<char, 4096> buf;
+  size_t n;
+  while ((n = fread(buf.data(), 1, buf.size(), pipe)) > 0) {
+    r.output.append(buf.data(), n);
+  }
+  const int status = pclose(pipe);
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+class Cli : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    root_ = new fs::path(fs::temp_directory_path() / ("monomap_cli_test_" + std::to_string(getpid())));
+    fs::remove_all(*root_);
+    fs::create_directories(*root_);
+    SimulationOptions sim;
+    sim.world = "lab-corner";
+    sim.num_frames = 40;
+    sim.width = 320;
+    sim.height = 240;
+    Simulate(sim, *root_ / "data");
+  }
+  static void TearDownTestSuite() {
+    fs::remove_all(*root_);
+    delete root_;
+  }
+  // A copy of the good dataset to corrupt.
+  static fs::path CopyData(const std::string& name) {
+    const fs::path dst = *root_ / name;
+    fs::remove_all(dst);
+    fs::copy(*root_ / "data", dst, fs::copy_options::recursive);
+    return dst;
+  }
+  static fs::path* root_;
+};
+fs::path* Cli::root_ = nullptr;
+
+TEST_F(Cli, BuildWritesAReadableMap) {
+  const fs::path out = *root_ / "map_ok";
+  const RunResult r = RunMonomap("build " + (*root_ / "data").string() + " -o " +
+                          out.string() + " -q --report " +
+                          (*root_ / "report.json").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const Map map = ReadMap(out);
+  EXPECT_EQ(map.trajectory.size(), 40u);
+  EXPECT_GT(map.landmarks.size(), 50u);
+  EXPECT_TRUE(fs::exists(out / "features.csv"));
+  EXPECT_TRUE(fs::exists(*root_ / "report.json"));
+}
+
+TEST_F(Cli, MalformedOdometryLineIsNamedAndNothingIsWritten) {
+  const fs::path data = CopyData("bad_odometry");
+  {
+    std::ofstream odo(data / "odometry.txt", std::ios::app);
+    odo << "99999 1 2 3\n";
+  }
+  const fs::path out = *root_ / "map_bad";
+  const RunResult r =
+      RunMonomap("build " + data.string() + " -o " + out.string() + " -q");
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("odometry.txt:"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("expected 8 values"), std::string::npos)
+      << r.output;
+  EXPECT_FALSE(fs::exists(out));
+  // No temporary directory is left behind either.
+  for (const auto& e : fs::directory_iterator(*root_)) {
+    EXPECT_EQ(e.path().filename().string().find(".map_bad"),
+              std::string::npos);
+  }
+}
+
+TEST_F(Cli, MissingImageAndWrongSizeAreNamed) {
+  const fs::path data = CopyData("bad_image");
+  fs::remove(data / "rgb" / "000003.png");
+  RunResult r = RunMonomap("build " + data.string() + " -o " +
+                    (*root_ / "m").string() + " -q");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.output.find("rgb.txt:"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("not found"), std::string::npos) << r.output;
+}
+
+TEST_F(Cli, UsageErrorsExitWithTwo) {
+  EXPECT_EQ(RunMonomap("build").exit_code, 2);
+  EXPECT_EQ(RunMonomap("no-such-command").exit_code, 2);
+}
+
+TEST_F(Cli, MissingDatasetIsNamed) {
+  const RunResult r = RunMonomap("build /nonexistent/ds -o /tmp/x -q");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.output.find("/nonexistent/ds"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace monomap
