@@ -11,5 +11,7 @@ void RegisterBuildCommand(CLI::App& app);
 void RegisterEvalCommand(CLI::App& app);
 void RegisterSimulateCommand(CLI::App& app);
 void RegisterDemoCommand(CLI::App& app);
+void RegisterRenderCommand(CLI::App& app);
+void RegisterLocalizeCommand(CLI::App& app);
 
 }  // namespace monomap

@@ -4,6 +4,7 @@
 #include <iostream>
 #include <memory>
 
+#include "monomap/eval/checkerboard_accuracy.h"
 #include "monomap/eval/point_accuracy.h"
 #include "monomap/eval/report_json.h"
 #include "monomap/eval/trajectory_metrics.h"
@@ -101,6 +102,41 @@ void RegisterEvalCommand(CLI::App& app) {
     nlohmann::json j = ToJson(acc);
     j["plane_label"] = label;
     PrintOrWrite(j, FormatTable(acc), pa->json);
+  });
+
+  struct BoardArgs {
+    std::string map_dir, structure, json;
+  };
+  auto ba = std::make_shared<BoardArgs>();
+  CLI::App* board = eval->add_subcommand(
+      "checkerboard",
+      "Find a known checkerboard in the plane textures and compare its "
+      "corners, mapped to 3D, with their true positions");
+  board->add_option("map", ba->map_dir, "Map directory")->required();
+  board->add_option("--structure", ba->structure,
+                    "Ground-truth structure YAML with a 'chessboard' entry")
+      ->required();
+  board->add_option("--json", ba->json, "Write the figures as JSON");
+  board->callback([ba]() {
+    const Map map = ReadMap(ba->map_dir);
+    const CheckerboardSpec spec = ReadCheckerboardYaml(ba->structure);
+    const CheckerboardAccuracy acc = EvaluateCheckerboard(map, spec);
+    nlohmann::json j;
+    j["found"] = acc.found;
+    j["plane_id"] = acc.plane_id;
+    j["corners_found"] = acc.corners_found;
+    j["corners_expected"] = spec.inner_corners_x * spec.inner_corners_y;
+    if (acc.found) j["error_m"] = ToJson(acc.error_m);
+    char table[256];
+    std::snprintf(table, sizeof(table),
+                  "checkerboard %dx%d: %s in plane %d, corner error mean "
+                  "%.2f mm, median %.2f mm, max %.2f mm\n",
+                  spec.inner_corners_x, spec.inner_corners_y,
+                  acc.found ? "found" : "NOT found", acc.plane_id,
+                  acc.error_m.mean * 1e3, acc.error_m.median * 1e3,
+                  acc.error_m.max * 1e3);
+    PrintOrWrite(j, table, ba->json);
+    if (!acc.found) throw StageError("checkerboard not found in any texture");
   });
 
   struct TrajArgs {

@@ -17,6 +17,8 @@ int main(int argc, char** argv) {
   monomap::RegisterBuildCommand(app);
   monomap::RegisterEvalCommand(app);
   monomap::RegisterSimulateCommand(app);
+  monomap::RegisterRenderCommand(app);
+  monomap::RegisterLocalizeCommand(app);
   monomap::RegisterDemoCommand(app);
   try {
     app.parse(argc, argv);

@@ -1,0 +1,110 @@
+#include "monomap/eval/checkerboard_accuracy.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <limits>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "monomap/util/error.h"
+#include "monomap/util/file.h"
+
+namespace monomap {
+
+CheckerboardAccuracy EvaluateCheckerboard(const Map& map,
+                                          const CheckerboardSpec& spec) {
+  CheckerboardAccuracy result;
+  const cv::Size pattern(spec.inner_corners_x, spec.inner_corners_y);
+  for (const TexturedPlane& plane : map.planes) {
+    if (plane.texture.empty()) continue;
+    cv::Mat grey;
+    cv::cvtColor(plane.texture, grey, plane.texture.channels() == 4
+                                          ? cv::COLOR_BGRA2GRAY
+                                          : cv::COLOR_BGR2GRAY);
+    std::vector<cv::Point2f> corners;
+    if (!cv::findChessboardCorners(
+            grey, pattern, corners,
+            cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE)) {
+      continue;
+    }
+    cv::cornerSubPix(
+        grey, corners, cv::Size(5, 5), cv::Size(-1, -1),
+        cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 40,
+                         0.01));
+    std::vector<Eigen::Vector3d> mapped;
+    for (const auto& c : corners) {
+      mapped.push_back(plane.WorldFromTexture(Eigen::Vector2d(c.x, c.y)));
+    }
+    // OpenCV orders corners row by row along the pattern's width (x),
+    // starting at any of the board's four corners (and the texture may be
+    // mirrored relative to the board axes): try the four orderings and keep
+    // the one with the smallest error.
+    const int nx = spec.inner_corners_x, ny = spec.inner_corners_y;
+    ErrorStats best;
+    best.mean = std::numeric_limits<double>::infinity();
+    std::vector<Eigen::Vector3d> best_order;
+    for (int flip = 0; flip < 4; ++flip) {
+      std::vector<double> errors;
+      std::vector<Eigen::Vector3d> order(mapped.size());
+      for (int k = 0; k < static_cast<int>(mapped.size()); ++k) {
+        int i = k % nx, j = k / nx;
+        if (flip & 1) i = nx - 1 - i;
+        if (flip & 2) j = ny - 1 - j;
+        errors.push_back((mapped[k] - spec.Corner(i, j)).norm());
+        order[j * nx + i] = mapped[k];
+      }
+      const ErrorStats e = ComputeErrorStats(errors);
+      if (e.mean < best.mean) {
+        best = e;
+        best_order = order;
+      }
+    }
+    mapped = best_order;
+    result.found = true;
+    result.plane_id = plane.id;
+    result.corners_found = static_cast<int>(mapped.size());
+    result.error_m = best;
+    result.corners_in_world = mapped;
+    return result;
+  }
+  return result;
+}
+
+CheckerboardSpec ReadCheckerboardYaml(const std::filesystem::path& path) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(ReadFileToString(path));
+  } catch (const YAML::Exception& e) {
+    throw InputError(path.string(), e.mark.line + 1,
+                     "malformed YAML: " + e.msg);
+  }
+  const YAML::Node b = root["chessboard"];
+  if (!b) throw InputError(path.string(), "chessboard", "missing");
+  CheckerboardSpec spec;
+  try {
+    spec.inner_corners_x = b["inner_corners_x"].as<int>();
+    spec.inner_corners_y = b["inner_corners_y"].as<int>();
+    spec.square_m = b["square_m"].as<double>();
+    auto vec = [&](const char* key, Eigen::Vector3d* v) {
+      if (!b[key]) return;
+      const auto values = b[key].as<std::vector<double>>();
+      if (values.size() != 3) {
+        throw InputError(path.string(), std::string("chessboard.") + key,
+                         "expected 3 numbers");
+      }
+      *v = Eigen::Vector3d(values[0], values[1], values[2]);
+    };
+    vec("origin", &spec.origin);
+    vec("x_axis", &spec.x_axis);
+    vec("y_axis", &spec.y_axis);
+  } catch (const YAML::Exception& e) {
+    throw InputError(path.string(), "chessboard", e.msg);
+  }
+  if (spec.inner_corners_x < 2 || spec.inner_corners_y < 2 ||
+      spec.square_m <= 0) {
+    throw InputError(path.string(), "chessboard", "invalid board size");
+  }
+  return spec;
+}
+
+}  // namespace monomap

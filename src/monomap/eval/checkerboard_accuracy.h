@@ -1,0 +1,50 @@
+// Texture accuracy on a known checkerboard: find its inner corners in a
+// plane texture with OpenCV, map them to 3D through the texture mapping of
+// the map format, and compare with their true positions.
+#pragma once
+
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "monomap/eval/point_accuracy.h"
+#include "monomap/map/map.h"
+
+namespace monomap {
+
+struct CheckerboardSpec {
+  int inner_corners_x = 9;  // corners along the board's x axis
+  int inner_corners_y = 6;  // corners along the board's y axis
+  double square_m = 0.04;
+  // World position of corner (0, 0) and the board axes.
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();
+  Eigen::Vector3d x_axis = Eigen::Vector3d::UnitX();
+  Eigen::Vector3d y_axis = Eigen::Vector3d::UnitY();
+
+  Eigen::Vector3d Corner(int i, int j) const {
+    return origin + square_m * (i * x_axis + j * y_axis);
+  }
+};
+
+struct CheckerboardAccuracy {
+  bool found = false;
+  int plane_id = -1;
+  int corners_found = 0;
+  // Distances between the mapped texture corners and the true corners (m).
+  ErrorStats error_m;
+  // Mapped corner positions in world coordinates, in the spec's order.
+  std::vector<Eigen::Vector3d> corners_in_world;
+};
+
+// Searches every plane texture for the board (cv::findChessboardCorners +
+// cornerSubPix) and returns the first plane where all inner corners are
+// found. The detection's ordering ambiguity (start corner, mirroring) is
+// resolved by taking the ordering with the smallest error.
+CheckerboardAccuracy EvaluateCheckerboard(const Map& map,
+                                          const CheckerboardSpec& spec);
+
+// Reads the `chessboard:` entry of a ground-truth structure YAML
+// ({inner_corners_x, inner_corners_y, square_m, origin, x_axis, y_axis}).
+CheckerboardSpec ReadCheckerboardYaml(const std::filesystem::path& path);
+
+}  // namespace monomap
