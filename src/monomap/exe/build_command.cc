@@ -21,6 +21,7 @@ void RegisterBuildCommand(CLI::App& app) {
     bool points_only = false;
     int ransac_iterations = 2000;
     bool quiet = false;
+    bool ba_verbose = false;
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
@@ -42,6 +43,8 @@ void RegisterBuildCommand(CLI::App& app) {
   cmd->add_option("--ransac-iterations", args->ransac_iterations,
                   "RANSAC hypotheses per plane");
   cmd->add_flag("-q,--quiet", args->quiet, "No progress output");
+  cmd->add_flag("--ba-verbose", args->ba_verbose,
+                "Print the bundle adjustment solver's progress and report");
   cmd->callback([args]() {
     DatasetOptions dataset_options;
     dataset_options.first_frame = args->first_frame;
@@ -53,6 +56,7 @@ void RegisterBuildCommand(CLI::App& app) {
     MappingOptions options;
     options.bundle_adjustment.enabled = !args->no_bundle_adjustment;
     options.points_only = args->points_only;
+    options.bundle_adjustment.verbose = args->ba_verbose;
     options.planes.ransac_iterations = args->ransac_iterations;
     options.show_progress = !args->quiet;
     const MappingResult result = BuildMap(dataset, options);

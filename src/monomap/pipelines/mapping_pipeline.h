@@ -36,6 +36,9 @@ struct MappingOptions {
   // The first triangulation (against odometry poses, before bundle
   // adjustment) accepts reprojection errors this many times larger.
   double first_pass_error_factor = 4.0;
+  // Bundle adjustment runs on every n-th frame (1: all frames); the other
+  // frames get the interpolated correction of their neighbours.
+  int keyframe_interval = 3;
   // Stop after triangulation + bundle adjustment (a point map only).
   bool points_only = false;
   // Draw progress bars on stderr (only when it is a terminal).
