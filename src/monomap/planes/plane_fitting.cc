@@ -36,6 +36,10 @@ void PlaneFittingOptions::Check() const {
               "planes.max_connectivity_radius_m",
               "must be >= min_connectivity_radius_m");
   CheckOption(max_planes > 0, "planes.max_planes", "must be > 0");
+  CheckOption(ghost_max_angle_deg >= 0, "planes.ghost_max_angle_deg",
+              "must be >= 0");
+  CheckOption(ghost_distance_factor >= 0, "planes.ghost_distance_factor",
+              "must be >= 0");
   CheckOption(max_consecutive_failures >= 1, "planes.max_consecutive_failures",
               "must be >= 1");
   CheckOption(polygon_cell_factor > 0, "planes.polygon_cell_factor",
@@ -298,6 +302,30 @@ PlaneFittingReport FitPlanes(
       plane = refined;
       if (reselected == inliers) break;
       inliers = std::move(reselected);
+    }
+
+    // A "ghost": nearly the same plane as an accepted segment, made of the
+    // points just outside that segment's threshold (its noisier points).
+    // They are outliers of the real plane, not a second surface.
+    bool ghost = false;
+    for (const PlaneSegment& seg : *segments) {
+      if (PlaneAngle(seg.plane, plane) >
+          options.ghost_max_angle_deg * M_PI / 180.0) {
+        continue;
+      }
+      double dist = 0.0, thr = 0.0;
+      for (size_t k : inliers) {
+        dist += std::abs(seg.plane.SignedDistance(pts[k]));
+        thr += 1.0 / inv_thr[k];
+      }
+      if (dist < options.ghost_distance_factor * thr) ghost = true;
+    }
+    if (ghost) {
+      ++report.rejected_hypotheses;
+      ++failures;
+      for (size_t k : inliers) taken[remaining[k]] = 1;
+      std::erase_if(remaining, [&](int i) { return taken[i] != 0; });
+      continue;
     }
 
     // Split the inliers into connected regions of the plane.

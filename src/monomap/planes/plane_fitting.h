@@ -57,6 +57,13 @@ struct PlaneFittingOptions {
   // what is left is noise. Their inliers are set aside meanwhile, so the
   // search moves on.
   int max_consecutive_failures = 3;
+  // A new plane within this angle (deg) of an accepted segment whose inliers
+  // lie on average within ghost_distance_factor x their threshold of that
+  // segment's plane is a "ghost" (the segment's noisier points) and is
+  // rejected; its points become outliers.
+  double ghost_max_angle_deg = 3.0;
+  // See ghost_max_angle_deg.
+  double ghost_distance_factor = 3.0;
   // Polygon of a segment: false = convex hull of its inliers; true = the
   // outline of the occupancy grid of its inliers (follows concave shapes).
   bool concave_polygon = true;

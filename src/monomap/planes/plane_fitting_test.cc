@@ -251,6 +251,43 @@ TEST(FitPlanes, PlaneThroughSeveralSmallObjectsIsRejected) {
   EXPECT_GE(floor_in, 0.995 * floor_total);
 }
 
+TEST(FitPlanes, NoisyTailOfAPlaneIsNotASecondPlane) {
+  // A floor whose points have a heavy-tailed error (15% of them 4-9 mm off,
+  // like badly triangulated points): the tail must not become a "ghost"
+  // plane parallel to the floor; real planes elsewhere are still found.
+  std::mt19937_64 rng(8);
+  std::uniform_real_distribution<double> uni(0.0, 1.0);
+  std::normal_distribution<double> noise(0.0, 0.001);
+  std::vector<Landmark> lms;
+  auto push = [&](const Eigen::Vector3d& x) {
+    Landmark lm;
+    lm.id = static_cast<FeatureId>(lms.size());
+    lm.x_in_world = x;
+    lm.mean_depth_m = 0.4;  // threshold 4 mm
+    lms.push_back(lm);
+  };
+  for (int i = 0; i < 2000; ++i) {
+    const double z = uni(rng) < 0.15 ? 0.004 + 0.005 * uni(rng) : noise(rng);
+    push({uni(rng), uni(rng), z});
+  }
+  for (int i = 0; i < 300; ++i) push({1.2, uni(rng), 0.5 * uni(rng)});
+  std::vector<PlaneSegment> segments;
+  const auto report = FitPlanes(PlaneFittingOptions(), &lms, &segments);
+  ASSERT_EQ(segments.size(), 2u);
+  EXPECT_GE(report.rejected_hypotheses, 1);
+  for (const auto& seg : segments) {
+    const double c = std::abs(seg.plane.normal.z());
+    EXPECT_TRUE(c > 0.9999 || c < 0.01) << seg.plane.normal.transpose();
+  }
+  // With ghost rejection off, the tail does form a second parallel plane.
+  PlaneFittingOptions no_ghost;
+  no_ghost.ghost_max_angle_deg = 0.0;
+  std::vector<PlaneSegment> with_ghosts;
+  for (auto& lm : lms) lm.plane_id = -1;
+  FitPlanes(no_ghost, &lms, &with_ghosts);
+  EXPECT_GT(with_ghosts.size(), 2u);
+}
+
 TEST(FitPlanes, ConcaveOutlineOfRectanglesKeepsTheirArea) {
   Scene scene = MakeScene(3);
   std::vector<PlaneSegment> segments;
