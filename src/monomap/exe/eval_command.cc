@@ -104,6 +104,75 @@ void RegisterEvalCommand(CLI::App& app) {
     PrintOrWrite(j, FormatTable(acc), pa->json);
   });
 
+  struct PlaneArgs {
+    std::string map_dir, surface_ply, plane_yaml, json;
+    double spacing_m = 0.01;
+  };
+  auto pl = std::make_shared<PlaneArgs>();
+  CLI::App* planes = eval->add_subcommand(
+      "planes",
+      "Distance of samples of each textured plane (its seen texels) to the "
+      "true surface");
+  planes->add_option("map", pl->map_dir, "Map directory")->required();
+  auto* pl_surface =
+      planes->add_option("--surface", pl->surface_ply, "Ground-truth PLY");
+  auto* pl_plane = planes->add_option("--plane", pl->plane_yaml,
+                                      "Ground-truth structure YAML (plane)");
+  pl_surface->excludes(pl_plane);
+  planes->add_option("--spacing", pl->spacing_m, "Sample spacing (m)");
+  planes->add_option("--json", pl->json, "Write the figures as JSON");
+  planes->callback([pl]() {
+    if (pl->plane_yaml.empty() == pl->surface_ply.empty()) {
+      throw OptionsError("eval planes: give exactly one of --plane or "
+                         "--surface");
+    }
+    const Map map = ReadMap(pl->map_dir);
+    std::unique_ptr<NearestNeighborIndex> index;
+    Plane truth;
+    if (!pl->surface_ply.empty()) {
+      index = std::make_unique<NearestNeighborIndex>(
+          ReadPlyPoints(pl->surface_ply));
+    } else {
+      truth = ReadGroundTruthPlaneYaml(pl->plane_yaml);
+    }
+    nlohmann::json j;
+    j["num_planes"] = map.planes.size();
+    j["planes"] = nlohmann::json::array();
+    std::vector<double> all;
+    std::string table = "plane  samples  median(mm)  p90(mm)  max(mm)\n";
+    for (const TexturedPlane& p : map.planes) {
+      // Texel centres the images saw, one every `spacing` metres.
+      const int stride =
+          std::max(1, static_cast<int>(pl->spacing_m * p.pixels_per_meter));
+      std::vector<double> d;
+      for (int r = 0; r < p.texture.rows; r += stride) {
+        for (int c = 0; c < p.texture.cols; c += stride) {
+          if (p.texture.channels() == 4 &&
+              p.texture.at<cv::Vec4b>(r, c)[3] == 0) {
+            continue;
+          }
+          const Eigen::Vector3d x = p.WorldFromTexture(Eigen::Vector2d(c, r));
+          d.push_back(index ? index->NearestDistance(x)
+                            : std::abs(truth.SignedDistance(x)));
+        }
+      }
+      all.insert(all.end(), d.begin(), d.end());
+      const ErrorStats e = ComputeErrorStats(d);
+      j["planes"].push_back({{"id", p.id}, {"distance_m", ToJson(e)}});
+      char line[160];
+      std::snprintf(line, sizeof(line), "%5d  %7zu  %10.2f  %7.2f  %7.2f\n",
+                    p.id, e.count, e.median * 1e3, e.p90 * 1e3, e.max * 1e3);
+      table += line;
+    }
+    const ErrorStats e = ComputeErrorStats(all);
+    j["all"] = ToJson(e);
+    char line[160];
+    std::snprintf(line, sizeof(line), "  all  %7zu  %10.2f  %7.2f  %7.2f\n",
+                  e.count, e.median * 1e3, e.p90 * 1e3, e.max * 1e3);
+    table += line;
+    PrintOrWrite(j, table, pl->json);
+  });
+
   struct BoardArgs {
     std::string map_dir, structure, json;
   };
