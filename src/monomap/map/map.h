@@ -44,6 +44,12 @@ struct Landmark {
   // Mean distance (m) from the observing camera centres: depth uncertainty
   // grows with it, so plane fitting scales its inlier threshold by it.
   double mean_depth_m = 0.0;
+  // Covariance of x_in_world (m^2) for observations with 1 px isotropic
+  // noise, (J^T J)^-1 of the reprojection error at the solution: how well
+  // the viewing geometry fixes the point in each direction (a far point
+  // seen along a short baseline is loose along its rays). Scale by the
+  // tracker's noise squared. Zero when unknown.
+  Eigen::Matrix3d covariance_m2_per_px2 = Eigen::Matrix3d::Zero();
   int plane_id = -1;  // index of the plane it lies on, -1 if none
 };
 

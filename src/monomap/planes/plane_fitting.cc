@@ -19,6 +19,10 @@ void PlaneFittingOptions::Check() const {
   CheckOption(min_threshold_m > 0, "planes.min_threshold_m", "must be > 0");
   CheckOption(relative_threshold >= 0, "planes.relative_threshold",
               "must be >= 0");
+  CheckOption(tracking_noise_px >= 0 && std::isfinite(tracking_noise_px),
+              "planes.tracking_noise_px", "must be finite and >= 0");
+  CheckOption(covariance_sigmas >= 0 && std::isfinite(covariance_sigmas),
+              "planes.covariance_sigmas", "must be finite and >= 0");
   CheckOption(max_threshold_m >= min_threshold_m, "planes.max_threshold_m",
               "must be >= min_threshold_m");
   CheckOption(refine_iterations >= 0, "planes.refine_iterations",
@@ -44,6 +48,25 @@ void PlaneFittingOptions::Check() const {
               "must be >= 1");
   CheckOption(polygon_cell_factor > 0, "planes.polygon_cell_factor",
               "must be > 0");
+}
+
+PointThreshold MakePointThreshold(const PlaneFittingOptions& options,
+                                  const Landmark& landmark) {
+  PointThreshold t;
+  t.min_m = options.min_threshold_m;
+  t.max_m = options.max_threshold_m;
+  const double depth = landmark.mean_depth_m;
+  if (std::isfinite(depth) && depth > 0) {
+    t.depth_term_m = options.relative_threshold * depth;
+  }
+  const Eigen::Matrix3d& c = landmark.covariance_m2_per_px2;
+  if (c.allFinite()) {
+    const double k = options.covariance_sigmas * options.tracking_noise_px;
+    const double k2 = k * k;
+    t.scaled_cov = {k2 * c(0, 0), k2 * c(0, 1), k2 * c(0, 2),
+                    k2 * c(1, 1), k2 * c(1, 2), k2 * c(2, 2)};
+  }
+  return t;
 }
 
 namespace {
@@ -241,25 +264,20 @@ PlaneFittingReport FitPlanes(
   report.num_points = n;
 
   // Per-landmark threshold; invalid points never enter the search.
-  std::vector<double> thresholds(n, options.min_threshold_m);
+  std::vector<PointThreshold> thresholds(n);
   std::vector<int> remaining;
   remaining.reserve(n);
   for (int i = 0; i < n; ++i) {
     lms[i].plane_id = -1;
     if (!lms[i].x_in_world.allFinite()) continue;
-    const double depth = lms[i].mean_depth_m;
-    if (std::isfinite(depth) && depth > 0) {
-      thresholds[i] =
-          std::clamp(options.relative_threshold * depth,
-                     options.min_threshold_m, options.max_threshold_m);
-    }
+    thresholds[i] = MakePointThreshold(options, lms[i]);
     remaining.push_back(i);
   }
   const size_t min_count = static_cast<size_t>(std::max<double>(
       options.min_inliers, std::ceil(options.min_inlier_fraction * n)));
 
   std::vector<Eigen::Vector3d> pts;
-  std::vector<double> inv_thr;
+  std::vector<PointThreshold> thr;
   std::vector<char> taken(n, 0);  // on a segment or set aside
   int failures = 0;
   for (int attempt = 0;
@@ -268,12 +286,12 @@ PlaneFittingReport FitPlanes(
        failures < options.max_consecutive_failures;
        ++attempt) {
     pts.resize(remaining.size());
-    inv_thr.resize(remaining.size());
+    thr.resize(remaining.size());
     for (size_t k = 0; k < remaining.size(); ++k) {
       pts[k] = lms[remaining[k]].x_in_world;
-      inv_thr[k] = 1.0 / thresholds[remaining[k]];
+      thr[k] = thresholds[remaining[k]];
     }
-    const PlaneEstimator estimator{&pts, &inv_thr};
+    const PlaneEstimator estimator{&pts, &thr};
     RansacOptions ransac;
     ransac.max_iterations = options.ransac_iterations;
     ransac.min_iterations =
@@ -313,12 +331,12 @@ PlaneFittingReport FitPlanes(
           options.ghost_max_angle_deg * M_PI / 180.0) {
         continue;
       }
-      double dist = 0.0, thr = 0.0;
+      double dist = 0.0, band = 0.0;
       for (size_t k : inliers) {
         dist += std::abs(seg.plane.SignedDistance(pts[k]));
-        thr += 1.0 / inv_thr[k];
+        band += thr[k](seg.plane.normal);
       }
-      if (dist < options.ghost_distance_factor * thr) ghost = true;
+      if (dist < options.ghost_distance_factor * band) ghost = true;
     }
     if (ghost) {
       ++report.rejected_hypotheses;

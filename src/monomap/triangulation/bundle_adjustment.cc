@@ -477,6 +477,7 @@ BundleAdjustmentReport BundleAdjust(const Camera& camera,
     l.mean_reprojection_error_px = s.mean_error_px;
     l.triangulation_angle_deg = s.triangulation_angle_deg;
     l.mean_depth_m = s.mean_distance_m;
+    l.covariance_m2_per_px2 = s.covariance_m2_per_px2;
     kept.push_back(l);
   }
   *landmarks = std::move(kept);

@@ -170,6 +170,19 @@ PointStatistics EvaluatePoint(const Camera& camera,
   s.mean_distance_m = sum_distance / n;
   s.triangulation_angle_deg =
       MaxTriangulationAngle(cams, x_in_world) * kRadToDeg;
+  std::vector<Eigen::Vector2d> observed;
+  observed.reserve(track.observations.size());
+  for (const Observation& obs : track.observations) observed.push_back(obs.px);
+  Eigen::Matrix3d jtj;
+  Eigen::Vector3d jtr;
+  if (std::isfinite(PointCost(internal::Intrinsics(camera), cams, observed,
+                              x_in_world, &jtj, &jtr))) {
+    const Eigen::LDLT<Eigen::Matrix3d> ldlt(jtj);
+    if (ldlt.info() == Eigen::Success && ldlt.isPositive() &&
+        ldlt.vectorD().minCoeff() > 1e-12 * ldlt.vectorD().maxCoeff()) {
+      s.covariance_m2_per_px2 = ldlt.solve(Eigen::Matrix3d::Identity());
+    }
+  }
   return s;
 }
 
@@ -265,6 +278,7 @@ TriangulationReport TriangulateTracks(const Camera& camera,
             l.mean_reprojection_error_px = s.mean_error_px;
             l.triangulation_angle_deg = s.triangulation_angle_deg;
             l.mean_depth_m = s.mean_distance_m;
+            l.covariance_m2_per_px2 = s.covariance_m2_per_px2;
           }
         }
       });

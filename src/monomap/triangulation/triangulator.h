@@ -79,6 +79,9 @@ struct PointStatistics {
   double max_depth_m = 0.0;  // largest z over the observing cameras
   double mean_distance_m = 0.0;  // mean distance to the camera centres
   double triangulation_angle_deg = 0.0;
+  // Covariance of the point for 1 px observation noise (see
+  // Landmark::covariance_m2_per_px2); zero if the geometry does not fix it.
+  Eigen::Matrix3d covariance_m2_per_px2 = Eigen::Matrix3d::Zero();
 };
 
 // Evaluates x_in_world against a track's observations; cams_from_world is
