@@ -55,6 +55,22 @@ bool PointInPolygon(const Polygon2d& polygon, const Eigen::Vector2d& p) {
   return inside;
 }
 
+double DistanceToPolygon(const Polygon2d& polygon, const Eigen::Vector2d& p) {
+  if (polygon.empty()) return std::numeric_limits<double>::infinity();
+  if (polygon.size() >= 3 && PointInPolygon(polygon, p)) return 0.0;
+  double best = std::numeric_limits<double>::infinity();
+  for (size_t i = 0; i < polygon.size(); ++i) {
+    const Eigen::Vector2d& a = polygon[i];
+    const Eigen::Vector2d& b = polygon[(i + 1) % polygon.size()];
+    const Eigen::Vector2d ab = b - a;
+    const double len2 = ab.squaredNorm();
+    const double t =
+        len2 > 0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+    best = std::min(best, (a + t * ab - p).norm());
+  }
+  return best;
+}
+
 void PolygonBounds(const Polygon2d& polygon, Eigen::Vector2d* min,
                    Eigen::Vector2d* max) {
   *min = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());

@@ -19,6 +19,9 @@ double PolygonArea(const Polygon2d& polygon);
 // Even-odd point-in-polygon test (works for non-convex simple polygons).
 bool PointInPolygon(const Polygon2d& polygon, const Eigen::Vector2d& p);
 
+// Distance from p to the polygon: 0 inside it, else to its nearest edge.
+double DistanceToPolygon(const Polygon2d& polygon, const Eigen::Vector2d& p);
+
 // Axis-aligned bounds of a polygon: min and max corners.
 void PolygonBounds(const Polygon2d& polygon, Eigen::Vector2d* min,
                    Eigen::Vector2d* max);

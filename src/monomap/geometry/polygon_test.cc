@@ -24,3 +24,19 @@ TEST(Polygon, HullAreaAndInside) {
 
 }  // namespace
 }  // namespace monomap
+
+namespace monomap {
+namespace {
+
+TEST(Polygon, DistanceToPolygon) {
+  const Polygon2d square = {{0, 0}, {2, 0}, {2, 1}, {0, 1}};
+  EXPECT_DOUBLE_EQ(DistanceToPolygon(square, {1.0, 0.5}), 0.0);
+  EXPECT_NEAR(DistanceToPolygon(square, {3.0, 0.5}), 1.0, 1e-12);
+  EXPECT_NEAR(DistanceToPolygon(square, {1.0, -0.25}), 0.25, 1e-12);
+  // Beyond a corner: the distance to the corner.
+  EXPECT_NEAR(DistanceToPolygon(square, {3.0, 2.0}), std::sqrt(2.0), 1e-12);
+  EXPECT_TRUE(std::isinf(DistanceToPolygon({}, {0.0, 0.0})));
+}
+
+}  // namespace
+}  // namespace monomap

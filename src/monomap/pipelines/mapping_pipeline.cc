@@ -290,6 +290,7 @@ nlohmann::json MappingReport::ToJson() const {
       {"mean_pose_change_deg", bundle_adjustment.mean_pose_change_deg}};
   nlohmann::json planes_json = {{"planes", planes.num_planes},
                                 {"outliers", planes.num_outliers},
+                                {"absorbed_outliers", planes.absorbed},
                                 {"inliers_per_plane", planes.inliers_per_plane}};
   j["planes"] = planes_json;
   j["homographies"] = {

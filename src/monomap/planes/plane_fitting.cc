@@ -19,10 +19,6 @@ void PlaneFittingOptions::Check() const {
   CheckOption(min_threshold_m > 0, "planes.min_threshold_m", "must be > 0");
   CheckOption(relative_threshold >= 0, "planes.relative_threshold",
               "must be >= 0");
-  CheckOption(tracking_noise_px >= 0 && std::isfinite(tracking_noise_px),
-              "planes.tracking_noise_px", "must be finite and >= 0");
-  CheckOption(covariance_sigmas >= 0 && std::isfinite(covariance_sigmas),
-              "planes.covariance_sigmas", "must be finite and >= 0");
   CheckOption(max_threshold_m >= min_threshold_m, "planes.max_threshold_m",
               "must be >= min_threshold_m");
   CheckOption(refine_iterations >= 0, "planes.refine_iterations",
@@ -46,27 +42,12 @@ void PlaneFittingOptions::Check() const {
               "must be >= 0");
   CheckOption(max_consecutive_failures >= 1, "planes.max_consecutive_failures",
               "must be >= 1");
+  CheckOption(tracking_noise_px >= 0 && std::isfinite(tracking_noise_px),
+              "planes.tracking_noise_px", "must be finite and >= 0");
+  CheckOption(covariance_sigmas >= 0 && std::isfinite(covariance_sigmas),
+              "planes.covariance_sigmas", "must be finite and >= 0");
   CheckOption(polygon_cell_factor > 0, "planes.polygon_cell_factor",
               "must be > 0");
-}
-
-PointThreshold MakePointThreshold(const PlaneFittingOptions& options,
-                                  const Landmark& landmark) {
-  PointThreshold t;
-  t.min_m = options.min_threshold_m;
-  t.max_m = options.max_threshold_m;
-  const double depth = landmark.mean_depth_m;
-  if (std::isfinite(depth) && depth > 0) {
-    t.depth_term_m = options.relative_threshold * depth;
-  }
-  const Eigen::Matrix3d& c = landmark.covariance_m2_per_px2;
-  if (c.allFinite()) {
-    const double k = options.covariance_sigmas * options.tracking_noise_px;
-    const double k2 = k * k;
-    t.scaled_cov = {k2 * c(0, 0), k2 * c(0, 1), k2 * c(0, 2),
-                    k2 * c(1, 1), k2 * c(1, 2), k2 * c(2, 2)};
-  }
-  return t;
 }
 
 namespace {
@@ -241,6 +222,13 @@ Polygon2d OccupancyOutline(const std::vector<Eigen::Vector2d>& st,
   return poly;
 }
 
+// k * standard deviation of a landmark along unit normal n (0 if its
+// covariance is unknown).
+double CovarianceBand(const Landmark& l, const Eigen::Vector3d& n, double k) {
+  const double var = n.dot(l.covariance_m2_per_px2 * n);
+  return std::isfinite(var) && var > 0 ? k * std::sqrt(var) : 0.0;
+}
+
 uint64_t MixSeed(uint64_t seed, uint64_t k) {
   // splitmix64 step: decorrelates the seeds of successive RANSAC runs.
   uint64_t z = seed + 0x9e3779b97f4a7c15ULL * (k + 1);
@@ -264,20 +252,25 @@ PlaneFittingReport FitPlanes(
   report.num_points = n;
 
   // Per-landmark threshold; invalid points never enter the search.
-  std::vector<PointThreshold> thresholds(n);
+  std::vector<double> thresholds(n, options.min_threshold_m);
   std::vector<int> remaining;
   remaining.reserve(n);
   for (int i = 0; i < n; ++i) {
     lms[i].plane_id = -1;
     if (!lms[i].x_in_world.allFinite()) continue;
-    thresholds[i] = MakePointThreshold(options, lms[i]);
+    const double depth = lms[i].mean_depth_m;
+    if (std::isfinite(depth) && depth > 0) {
+      thresholds[i] =
+          std::clamp(options.relative_threshold * depth,
+                     options.min_threshold_m, options.max_threshold_m);
+    }
     remaining.push_back(i);
   }
   const size_t min_count = static_cast<size_t>(std::max<double>(
       options.min_inliers, std::ceil(options.min_inlier_fraction * n)));
 
   std::vector<Eigen::Vector3d> pts;
-  std::vector<PointThreshold> thr;
+  std::vector<double> inv_thr;
   std::vector<char> taken(n, 0);  // on a segment or set aside
   int failures = 0;
   for (int attempt = 0;
@@ -286,12 +279,12 @@ PlaneFittingReport FitPlanes(
        failures < options.max_consecutive_failures;
        ++attempt) {
     pts.resize(remaining.size());
-    thr.resize(remaining.size());
+    inv_thr.resize(remaining.size());
     for (size_t k = 0; k < remaining.size(); ++k) {
       pts[k] = lms[remaining[k]].x_in_world;
-      thr[k] = thresholds[remaining[k]];
+      inv_thr[k] = 1.0 / thresholds[remaining[k]];
     }
-    const PlaneEstimator estimator{&pts, &thr};
+    const PlaneEstimator estimator{&pts, &inv_thr};
     RansacOptions ransac;
     ransac.max_iterations = options.ransac_iterations;
     ransac.min_iterations =
@@ -331,12 +324,12 @@ PlaneFittingReport FitPlanes(
           options.ghost_max_angle_deg * M_PI / 180.0) {
         continue;
       }
-      double dist = 0.0, band = 0.0;
+      double dist = 0.0, thr = 0.0;
       for (size_t k : inliers) {
         dist += std::abs(seg.plane.SignedDistance(pts[k]));
-        band += thr[k](seg.plane.normal);
+        thr += 1.0 / inv_thr[k];
       }
-      if (dist < options.ghost_distance_factor * band) ghost = true;
+      if (dist < options.ghost_distance_factor * thr) ghost = true;
     }
     if (ghost) {
       ++report.rejected_hypotheses;
@@ -427,6 +420,21 @@ PlaneFittingReport FitPlanes(
                                            options.polygon_cell_factor * radius)
                         : ConvexHull(seg.inlier_st);
       report.inliers_per_plane.push_back(static_cast<int>(comp.size()));
+      if (options.absorb_consistent_points) {
+        const double k = options.covariance_sigmas * options.tracking_noise_px;
+        for (int lm : remaining) {
+          if (taken[lm]) continue;
+          const Eigen::Vector3d& x = lms[lm].x_in_world;
+          const double band = std::max(
+              thresholds[lm], CovarianceBand(lms[lm], seg.plane.normal, k));
+          if (std::abs(seg.plane.SignedDistance(x)) > band) continue;
+          const Eigen::Vector2d q = seg.frame.ToPlane(x);
+          if (DistanceToPolygon(seg.polygon, q) <= radius) {
+            taken[lm] = 1;
+            ++report.absorbed;
+          }
+        }
+      }
       segments->push_back(std::move(seg));
     }
     if (accepted) {

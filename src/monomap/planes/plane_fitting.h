@@ -5,15 +5,15 @@
 // over optim/ransac.h with a per-point, depth-scaled inlier threshold),
 // refine it by least squares while re-selecting inliers, split its inliers
 // into spatially connected regions in the plane, accept the regions that are
-// big enough as PlaneSegments, remove their points, repeat. Splitting makes
+// big enough as PlaneSegments, remove their points together with the points
+// that are consistent with an accepted segment within their own
+// uncertainty (see absorb_consistent_points), repeat. Splitting makes
 // a hypothesis through several objects fall apart into small pieces that
 // are rejected, and coplanar but disconnected surfaces become separate
 // segments.
 #pragma once
 
 #include <Eigen/Core>
-#include <algorithm>
-#include <array>
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -28,21 +28,12 @@ struct PlaneFittingOptions {
   int ransac_iterations = 2000;
   // Seed of the RANSAC sampler; the output is a function of it.
   uint64_t seed = 42;
-  // Inlier threshold of landmark i against a plane of normal n is
-  // clamp(max(relative_threshold * mean_depth_m,
-  //           covariance_sigmas * tracking_noise_px * sqrt(n^T C_i n)),
-  //       min_threshold_m, max_threshold_m)
-  // with C_i = Landmark::covariance_m2_per_px2: triangulation error grows
-  // with depth, and much more along the rays of a point seen over a short
-  // baseline, which a depth-only band would cut off its plane.
+  // Inlier threshold of landmark i is clamp(relative_threshold *
+  // mean_depth_m, min_threshold_m, max_threshold_m): triangulation error
+  // grows with depth, so far points get a wider band.
   double min_threshold_m = 0.002;
   // Threshold as a fraction of the landmark's mean depth.
   double relative_threshold = 0.01;
-  // Effective noise of a tracked position (px), drift included, that scales
-  // the landmark covariance; 0 disables the covariance term.
-  double tracking_noise_px = 1.0;
-  // Width of the covariance band in standard deviations.
-  double covariance_sigmas = 3.0;
   // Upper bound of the threshold so far points cannot glue planes together.
   double max_threshold_m = 0.05;
   // Least-squares refinements (each re-selects inliers) after RANSAC.
@@ -75,6 +66,20 @@ struct PlaneFittingOptions {
   double ghost_max_angle_deg = 3.0;
   // See ghost_max_angle_deg.
   double ghost_distance_factor = 3.0;
+  // After a segment is accepted, remaining points over its extent that lie
+  // within their uncertainty band of its plane can no longer seed planes
+  // (they stay outliers: unlabelled, not used for the fit). The band of a
+  // point is max(its inlier threshold, covariance_sigmas x
+  // tracking_noise_px x sigma_n) with sigma_n^2 = n^T C n, C =
+  // Landmark::covariance_m2_per_px2: far points seen over a short baseline
+  // are loose along their rays, beyond the depth-scaled threshold, and
+  // would otherwise gather into tilted "ghost" planes of a real one.
+  bool absorb_consistent_points = true;
+  // Effective noise of a tracked position (px), drift included, scaling the
+  // landmark covariance.
+  double tracking_noise_px = 1.0;
+  // Width of the uncertainty band in standard deviations.
+  double covariance_sigmas = 3.0;
   // Polygon of a segment: false = convex hull of its inliers; true = the
   // outline of the occupancy grid of its inliers (follows concave shapes).
   bool concave_polygon = true;
@@ -93,6 +98,7 @@ struct PlaneFittingReport {
   int iterations = 0;                  // RANSAC hypotheses drawn in total
   int rejected_hypotheses = 0;         // planes with no big enough region
   int discarded_regions = 0;           // connected regions too small to keep
+  int absorbed = 0;  // outliers consistent with a segment within uncertainty
   double seconds = 0.0;                // wall-clock time
 };
 
@@ -109,36 +115,14 @@ PlaneFittingReport FitPlanes(
     std::vector<PlaneSegment>* segments,
     const std::vector<Eigen::Vector3d>* camera_centers = nullptr);
 
-// Per-landmark inlier threshold of FitPlanes (see PlaneFittingOptions):
-// the depth term is fixed, the covariance term depends on the normal.
-struct PointThreshold {
-  double depth_term_m = 0.0;  // relative_threshold * depth
-  // Upper triangle of (k sigma)^2 C: xx, xy, xz, yy, yz, zz.
-  std::array<double, 6> scaled_cov = {0, 0, 0, 0, 0, 0};
-  double min_m = 0.0, max_m = 0.0;
-
-  double operator()(const Eigen::Vector3d& n) const {
-    const auto& c = scaled_cov;
-    const double along = n.x() * (c[0] * n.x() + 2.0 * (c[1] * n.y() + c[2] * n.z())) +
-                         n.y() * (c[3] * n.y() + 2.0 * c[4] * n.z()) +
-                         n.z() * c[5] * n.z();
-    return std::clamp(std::max(depth_term_m, std::sqrt(std::max(along, 0.0))),
-                      min_m, max_m);
-  }
-};
-
-// The threshold of a landmark under `options`.
-PointThreshold MakePointThreshold(const PlaneFittingOptions& options,
-                                  const Landmark& landmark);
-
 // RANSAC estimator of a plane from 3 points whose residual is the distance
-// divided by each point's own threshold along the model's normal, so
-// Ransac() runs with inlier_threshold = 1.
+// divided by each point's own threshold, so Ransac() runs with
+// inlier_threshold = 1.
 struct PlaneEstimator {
   using Model = Plane;
   static constexpr int kSampleSize = 3;
   const std::vector<Eigen::Vector3d>* points = nullptr;
-  const std::vector<PointThreshold>* thresholds = nullptr;
+  const std::vector<double>* inv_thresholds = nullptr;  // 1 / threshold_i
 
   size_t NumData() const { return points->size(); }
   void Fit(const std::vector<size_t>& sample,
@@ -150,8 +134,7 @@ struct PlaneEstimator {
     }
   }
   double Residual(const Model& model, size_t i) const {
-    return std::abs(model.SignedDistance((*points)[i])) /
-           (*thresholds)[i](model.normal);
+    return std::abs(model.SignedDistance((*points)[i])) * (*inv_thresholds)[i];
   }
 };
 
