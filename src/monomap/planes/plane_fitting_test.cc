@@ -395,10 +395,94 @@ TEST(FitPlanes, CheckRejectsBadOptions) {
   options.max_threshold_m = 0.001;  // below min_threshold_m
   EXPECT_THROW(options.Check(), OptionsError);
   options = PlaneFittingOptions();
+  options.tracking_noise_px = -1.0;
+  EXPECT_THROW(options.Check(), OptionsError);
+  options = PlaneFittingOptions();
+  options.covariance_sigmas = std::nan("");
+  EXPECT_THROW(options.Check(), OptionsError);
+  options = PlaneFittingOptions();
   options.min_inlier_fraction = 1.5;
   std::vector<Landmark> lms;
   std::vector<PlaneSegment> segments;
   EXPECT_THROW(FitPlanes(options, &lms, &segments), OptionsError);
+}
+
+}  // namespace
+}  // namespace monomap
+
+namespace monomap {
+namespace {
+
+// A floor of well-triangulated points, a "ghost" layer of far points seen
+// over a short baseline (loose along their grazing rays, 8 cm below the
+// floor and tilted by 1 degree, as triangulation leaves them), and a real
+// raised surface (a book, 5 cm up, tight points).
+std::vector<Landmark> FloorGhostAndBook(uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> uni(0.0, 1.0);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  std::vector<Landmark> lms;
+  auto push = [&](const Eigen::Vector3d& x, double depth,
+                  const Eigen::Matrix3d& cov) {
+    Landmark l;
+    l.id = static_cast<FeatureId>(lms.size());
+    l.x_in_world = x;
+    l.mean_depth_m = depth;
+    l.covariance_m2_per_px2 = cov;
+    lms.push_back(l);
+  };
+  const Eigen::Matrix3d tight = 1e-6 * Eigen::Matrix3d::Identity();
+  for (int i = 0; i < 1500; ++i) {
+    push({4.0 * uni(rng), 2.0 * uni(rng), 0.002 * noise(rng)}, 1.0, tight);
+  }
+  // Grazing rays 15 degrees below the horizontal, 20 cm sigma along them.
+  const Eigen::Vector3d ray =
+      Eigen::Vector3d(std::cos(15 * kPi / 180), 0, -std::sin(15 * kPi / 180));
+  const Eigen::Matrix3d loose = 0.2 * 0.2 * ray * ray.transpose() + tight;
+  const double tilt = std::tan(1.0 * kPi / 180);
+  for (int i = 0; i < 300; ++i) {
+    const double x = 1.0 + 3.0 * uni(rng), y = 2.0 * uni(rng);
+    push({x, y, -0.08 + tilt * (x - 2.5) + 0.005 * noise(rng)}, 2.0, loose);
+  }
+  for (int i = 0; i < 300; ++i) {
+    push({0.5 + 0.3 * uni(rng), 0.5 + 0.2 * uni(rng),
+          0.05 + 0.001 * noise(rng)},
+         1.0, tight);
+  }
+  return lms;
+}
+
+TEST(FitPlanes, LoosePointsConsistentWithAPlaneFormNoGhost) {
+  const std::vector<Eigen::Vector3d> cameras = {{-1.0, 1.0, 0.5}};
+  PlaneFittingOptions options;
+  // Without absorption the loose layer becomes a second floor.
+  {
+    std::vector<Landmark> lms = FloorGhostAndBook(5);
+    std::vector<PlaneSegment> segments;
+    options.absorb_consistent_points = false;
+    const auto report = FitPlanes(options, &lms, &segments, &cameras);
+    EXPECT_EQ(report.num_planes, 3);
+    EXPECT_EQ(report.absorbed, 0);
+  }
+  std::vector<Landmark> lms = FloorGhostAndBook(5);
+  std::vector<PlaneSegment> segments;
+  options.absorb_consistent_points = true;
+  const auto report = FitPlanes(options, &lms, &segments, &cameras);
+  ASSERT_EQ(report.num_planes, 2);  // floor and book
+  EXPECT_GE(report.absorbed, 280);
+  // Absorbed points stay outliers: unlabelled.
+  int labelled_ghost = 0;
+  for (size_t i = 1500; i < 1800; ++i) labelled_ghost += lms[i].plane_id >= 0;
+  EXPECT_EQ(labelled_ghost, 0);
+  // The book (tight points 5 cm up) is its own segment, not absorbed.
+  const PlaneSegment& book = segments[0].inlier_ids.size() < 1000
+                                 ? segments[0]
+                                 : segments[1];
+  EXPECT_GE(book.inlier_ids.size(), 290u);
+  EXPECT_NEAR(std::abs(book.plane.offset), 0.05, 0.002);
+  EXPECT_LT(PlaneAngle(book.plane, segments[0].plane) * 180 / kPi +
+                PlaneAngle(book.plane, segments[1].plane) * 180 / kPi,
+            1.0);
 }
 
 }  // namespace
