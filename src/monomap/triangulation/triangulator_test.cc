@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <random>
 
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
 
 #include "monomap/triangulation/synthetic_scene.h"
@@ -136,6 +138,41 @@ TEST(TriangulatorTest, NoisyTracksWithOutliersAndDegenerateCases) {
   const double median = Median(relative_errors);
   EXPECT_LT(median, 0.005);
   EXPECT_GT(median, 0.0002);  // the noise is really there
+}
+
+TEST(TriangulatorTest, CovarianceMatchesTheActualErrors) {
+  // With Gaussian pixel noise sigma, the error e of a refined point is
+  // approximately N(0, sigma^2 C): e^T (sigma^2 C)^-1 e is chi-square with
+  // 3 degrees of freedom (mean 3, median 2.37; measured 3.03 and 2.33).
+  SyntheticSceneOptions scene_options;
+  scene_options.num_tracks = 600;
+  scene_options.pixel_noise_px = 0.3;
+  scene_options.seed = 11;
+  const SyntheticScene scene = MakeSyntheticScene(scene_options);
+  std::vector<Landmark> landmarks;
+  TriangulateTracks(scene.camera, scene.world_from_cam, scene.tracks,
+                    TriangulationOptions(), &landmarks);
+  ASSERT_GT(landmarks.size(), 500u);
+  std::vector<double> mahalanobis2, anisotropy;
+  const double var = scene_options.pixel_noise_px * scene_options.pixel_noise_px;
+  for (const Landmark& l : landmarks) {
+    const Eigen::Matrix3d c = var * l.covariance_m2_per_px2;
+    ASSERT_GT(c.determinant(), 0.0);
+    const Eigen::Vector3d e = l.x_in_world - scene.points[l.id];
+    mahalanobis2.push_back(e.dot(c.ldlt().solve(e)));
+    // Depth is the loose direction: largest / smallest eigenvalue.
+    const Eigen::Vector3d ev =
+        Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(c).eigenvalues();
+    anisotropy.push_back(std::sqrt(ev(2) / ev(0)));
+  }
+  double mean = 0.0;
+  for (double m : mahalanobis2) mean += m;
+  mean /= mahalanobis2.size();
+  EXPECT_GT(mean, 2.4);
+  EXPECT_LT(mean, 3.8);
+  EXPECT_GT(Median(mahalanobis2), 1.8);
+  EXPECT_LT(Median(mahalanobis2), 3.0);
+  EXPECT_GT(Median(anisotropy), 5.0);  // measured 19
 }
 
 TEST(TriangulatorTest, LinearOnlyIsWorseThanRefined) {
