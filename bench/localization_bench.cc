@@ -122,5 +122,3 @@ BENCHMARK(BM_MccCorrect)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace monomap
-
-BENCHMARK_MAIN();

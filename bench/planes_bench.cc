@@ -65,5 +65,3 @@ BENCHMARK(BM_FitPlanes)->Arg(10000)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace monomap
-
-BENCHMARK_MAIN();

@@ -178,5 +178,3 @@ BENCHMARK(BM_Render)
 
 }  // namespace
 }  // namespace monomap
-
-BENCHMARK_MAIN();

@@ -119,5 +119,3 @@ BENCHMARK(BM_Mosaic)->Unit(benchmark::kMillisecond)->Iterations(3);
 
 }  // namespace
 }  // namespace monomap
-
-BENCHMARK_MAIN();

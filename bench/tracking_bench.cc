@@ -140,5 +140,3 @@ BENCHMARK(BM_LoadAndTrack)
 
 }  // namespace
 }  // namespace monomap
-
-BENCHMARK_MAIN();

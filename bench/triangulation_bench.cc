@@ -119,5 +119,3 @@ BENCHMARK(BM_BundleAdjust)
 
 }  // namespace
 }  // namespace monomap
-
-BENCHMARK_MAIN();

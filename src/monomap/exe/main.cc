@@ -5,16 +5,15 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
-#include <opencv2/core/utility.hpp>
 
 #include "monomap/exe/commands.h"
 #include "monomap/util/error.h"
+#include "monomap/util/runtime.h"
 
 int main(int argc, char** argv) {
-  // Parallelism comes from oneTBB. OpenCV's own thread pool, called from
-  // inside TBB tasks, oversubscribes the cores and its idle workers spin,
-  // which slowed tracking and bundle adjustment measurably.
-  cv::setNumThreads(1);
+  // One OpenCV thread (oneTBB does the parallelism) and an allocator that
+  // reuses freed image buffers: see util/runtime.h.
+  monomap::ConfigureRuntime();
   CLI::App app{
       "monomap: dense planar maps and localization from one camera and "
       "odometry"};

@@ -7,8 +7,10 @@
 
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
+#include <tbb/blocked_range.h>
 #include <tbb/concurrent_queue.h>
 #include <tbb/info.h>
+#include <tbb/parallel_for.h>
 #include <tbb/parallel_pipeline.h>
 
 #include "monomap/util/error.h"
@@ -37,6 +39,45 @@ void KltTrackerOptions::Check() const {
   CheckOption(grid_cols >= 1 && grid_rows >= 1, "grid_cols/grid_rows",
               "must be >= 1");
 }
+
+namespace {
+
+// cv::calcOpticalFlowPyrLK over chunks of the points in parallel (oneTBB):
+// the points are independent, so the result is the same as one call, but
+// the serial tracking stage no longer leaves the other cores idle.
+void ParallelPyrLk(const std::vector<cv::Mat>& from,
+                   const std::vector<cv::Mat>& to,
+                   const std::vector<cv::Point2f>& pts_in,
+                   std::vector<cv::Point2f>* pts_out,
+                   std::vector<uchar>* status, std::vector<float>* error,
+                   const KltTrackerOptions& options) {
+  const size_t n = pts_in.size();
+  pts_out->assign(n, cv::Point2f());
+  status->assign(n, 0);
+  error->assign(n, 0.0f);
+  const cv::Size window(options.window_size, options.window_size);
+  const cv::TermCriteria criteria(
+      cv::TermCriteria::COUNT | cv::TermCriteria::EPS,
+      options.lk_max_iterations, options.lk_epsilon);
+  // Chunks of >= 64 points amortise the per-call set-up of OpenCV.
+  tbb::parallel_for(
+      tbb::blocked_range<size_t>(0, n, 64),
+      [&](const tbb::blocked_range<size_t>& r) {
+        const std::vector<cv::Point2f> in(pts_in.begin() + r.begin(),
+                                          pts_in.begin() + r.end());
+        std::vector<cv::Point2f> out;
+        std::vector<uchar> st;
+        std::vector<float> err;
+        cv::calcOpticalFlowPyrLK(from, to, in, out, st, err, window,
+                                 options.pyramid_levels, criteria, 0,
+                                 options.lk_min_eigen_threshold);
+        std::copy(out.begin(), out.end(), pts_out->begin() + r.begin());
+        std::copy(st.begin(), st.end(), status->begin() + r.begin());
+        std::copy(err.begin(), err.end(), error->begin() + r.begin());
+      });
+}
+
+}  // namespace
 
 KltTracker::KltTracker(const KltTrackerOptions& options) : options_(options) {
   options_.Check();
@@ -90,19 +131,14 @@ void KltTracker::Track(int frame_index, const cv::Mat& grey,
   stats.frame = frame_index;
 
   if (last_frame_ >= 0 && !active_.empty()) {
-    const cv::Size window(options_.window_size, options_.window_size);
-    const cv::TermCriteria criteria(
-        cv::TermCriteria::COUNT | cv::TermCriteria::EPS,
-        options_.lk_max_iterations, options_.lk_epsilon);
     std::vector<cv::Point2f> prev_pts(active_.size());
     for (size_t i = 0; i < active_.size(); ++i) prev_pts[i] = active_[i].px;
 
     std::vector<cv::Point2f> next_pts;
     std::vector<uchar> status;
     std::vector<float> error;
-    cv::calcOpticalFlowPyrLK(prev_pyramid_, pyramid, prev_pts, next_pts,
-                             status, error, window, options_.pyramid_levels,
-                             criteria, 0, options_.lk_min_eigen_threshold);
+    ParallelPyrLk(prev_pyramid_, pyramid, prev_pts, &next_pts, &status,
+                  &error, options_);
 
     // Backward only for the features that survived the forward track.
     std::vector<size_t> forward_ok;
@@ -124,10 +160,8 @@ void KltTracker::Track(int frame_index, const cv::Mat& grey,
     if (!fwd_pts.empty()) {
       // No initial guess at the original position: starting there would
       // pull the backward track home even from content that changed.
-      cv::calcOpticalFlowPyrLK(pyramid, prev_pyramid_, fwd_pts, back_pts,
-                               back_status, back_error, window,
-                               options_.pyramid_levels, criteria, 0,
-                               options_.lk_min_eigen_threshold);
+      ParallelPyrLk(pyramid, prev_pyramid_, fwd_pts, &back_pts, &back_status,
+                    &back_error, options_);
     }
 
     const double margin = options_.border_margin_px;

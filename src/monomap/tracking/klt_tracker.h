@@ -168,7 +168,9 @@ struct TrackingReport {
 // threads at once, must be thread-safe; returns an 8-bit grey image). Image
 // decoding and pyramid building run in parallel with the serial tracking
 // (oneTBB pipeline). Fills `tracks` with the tracks of at least two
-// observations, sorted by id. Throws what load_grey throws, InputError for
+// observations, sorted by id. Within the tracking stage, Lucas-Kanade runs
+// over chunks of the features in parallel (same result as one call). Throws
+// what load_grey throws, InputError for
 // bad images, StageError if num_frames < 1.
 TrackingReport TrackFeatures(const std::function<cv::Mat(int)>& load_grey,
                              int num_frames, const KltTrackerOptions& options,
