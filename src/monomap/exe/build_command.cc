@@ -20,6 +20,8 @@ void RegisterBuildCommand(CLI::App& app) {
     bool no_bundle_adjustment = false;
     bool points_only = false;
     int ransac_iterations = 2000;
+    int keyframe_interval = MappingOptions().keyframe_interval;
+    int features = KltTrackerOptions().target_features;
     bool quiet = false;
     bool ba_verbose = false;
   };
@@ -42,6 +44,10 @@ void RegisterBuildCommand(CLI::App& app) {
                 "Stop after triangulation and bundle adjustment");
   cmd->add_option("--ransac-iterations", args->ransac_iterations,
                   "RANSAC hypotheses per plane");
+  cmd->add_option("--keyframe-interval", args->keyframe_interval,
+                  "Bundle-adjust every n-th frame (1: all frames)");
+  cmd->add_option("--features", args->features,
+                  "Features the tracker keeps alive per frame");
   cmd->add_flag("-q,--quiet", args->quiet, "No progress output");
   cmd->add_flag("--ba-verbose", args->ba_verbose,
                 "Print the bundle adjustment solver's progress and report");
@@ -58,6 +64,8 @@ void RegisterBuildCommand(CLI::App& app) {
     options.points_only = args->points_only;
     options.bundle_adjustment.verbose = args->ba_verbose;
     options.planes.ransac_iterations = args->ransac_iterations;
+    options.keyframe_interval = args->keyframe_interval;
+    options.tracking.target_features = args->features;
     options.show_progress = !args->quiet;
     const MappingResult result = BuildMap(dataset, options);
     WriteMappingResult(args->output, result);

@@ -4,6 +4,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
+#include "monomap/exe/cli_parse.h"
 #include "monomap/exe/commands.h"
 #include "monomap/io/dataset.h"
 #include "monomap/io/map_format.h"
@@ -18,6 +19,8 @@ void RegisterLocalizeCommand(CLI::App& app) {
     std::string map_dir, dataset, output, report, particles_out;
     std::string method = "mcl", init = "pose", state = "planar";
     int particles = 1000;
+    std::string mcc_size, measure_size;
+    int mcc_top_k = -1;
     int first_frame = 0, num_frames = -1;
     uint64_t seed = 1;
   };
@@ -35,6 +38,12 @@ void RegisterLocalizeCommand(CLI::App& app) {
   cmd->add_option("--state", a->state, "planar | 6dof")
       ->check(CLI::IsMember({"planar", "6dof"}));
   cmd->add_option("--particles", a->particles, "Particle budget");
+  cmd->add_option("--mcc-size", a->mcc_size,
+                  "WxH of the renders MCC tracks against (default 160x120)");
+  cmd->add_option("--mcc-top-k", a->mcc_top_k,
+                  "Heaviest particles MCC corrects per update (default 8)");
+  cmd->add_option("--measure-size", a->measure_size,
+                  "WxH of the renders the weights compare (default 80x60)");
   cmd->add_option("--first-frame", a->first_frame, "First dataset frame");
   cmd->add_option("--frames", a->num_frames, "Number of frames");
   cmd->add_option("--seed", a->seed, "Seed of the filter");
@@ -52,6 +61,15 @@ void RegisterLocalizeCommand(CLI::App& app) {
     options.init = ParseLocalizationInit(a->init);
     options.state = ParseLocalizationState(a->state);
     options.num_particles = a->particles;
+    if (!a->mcc_size.empty()) {
+      ParseImageSize(a->mcc_size, "--mcc-size", &options.mcc.width,
+                     &options.mcc.height);
+    }
+    if (!a->measure_size.empty()) {
+      ParseImageSize(a->measure_size, "--measure-size",
+                     &options.measurement.width, &options.measurement.height);
+    }
+    if (a->mcc_top_k >= 0) options.mcc_top_k = a->mcc_top_k;
     options.seed = a->seed;
     std::vector<TimedPose> trajectory;
     std::vector<std::vector<Particle>> sets;

@@ -4,6 +4,7 @@
 #include <memory>
 #include <opencv2/imgcodecs.hpp>
 
+#include "monomap/exe/cli_parse.h"
 #include "monomap/exe/commands.h"
 #include "monomap/io/map_format.h"
 #include "monomap/io/trajectory_io.h"
@@ -52,12 +53,7 @@ void RegisterRenderCommand(CLI::App& app) {
     Camera camera = map.camera.Pinhole();
     if (!a->size.empty()) {
       int w = 0, h = 0;
-      char x = 0;
-      if (std::sscanf(a->size.c_str(), "%d%c%d", &w, &x, &h) != 3 ||
-          x != 'x' || w <= 0 || h <= 0 || w > 16384 || h > 16384) {
-        throw OptionsError("--size: expected WxH like 160x120, got '" +
-                           a->size + "'");
-      }
+      ParseImageSize(a->size, "--size", &w, &h);
       camera = camera.Scaled(w, h);
     }
     RendererOptions options;

@@ -42,6 +42,7 @@ void LocalizerOptions::Check() const {
   noise6d.Check();
   measurement.Check();
   mcc.Check();
+  refine_mcc.Check();
   renderer.Check();
   CheckOption(mcc_top_k >= 0, "mcc_top_k", "must be >= 0");
   CheckOption(merge_translation_m >= 0, "merge_translation_m", "must be >= 0");
@@ -63,6 +64,25 @@ void LocalizerOptions::Check() const {
   CheckOption(cluster_angle_deg > 0, "cluster_angle_deg", "must be > 0");
 }
 
+namespace {
+
+// refine_mcc at the live camera's aspect, never larger than the camera:
+// upsampling the live image would only blur the tracks.
+MccOptions RefinementOptions(const LocalizerOptions& options,
+                             const Camera& camera) {
+  MccOptions o = options.refine_mcc;
+  if (camera.width > 0 && camera.height > 0) {
+    const double scale =
+        std::min(1.0, static_cast<double>(o.width) / camera.width);
+    o.width = std::max(16, static_cast<int>(std::lround(camera.width * scale)));
+    o.height =
+        std::max(16, static_cast<int>(std::lround(camera.height * scale)));
+  }
+  return o;
+}
+
+}  // namespace
+
 Localizer::Localizer(const Map& map, const Camera& camera,
                      const LocalizerOptions& options,
                      const std::optional<Rigid3d>& base_from_cam)
@@ -72,6 +92,7 @@ Localizer::Localizer(const Map& map, const Camera& camera,
       renderer_((options.Check(), map), options.renderer),
       measurement_(&renderer_, camera, options.measurement),
       corrector_(&renderer_, camera, options.mcc),
+      refiner_(&renderer_, camera, RefinementOptions(options, camera)),
       rng_(options.seed) {
   if (options_.state == LocalizationState::kPlanar && !base_from_cam_) {
     throw OptionsError("state: planar needs base_from_cam (camera mount)");
@@ -298,6 +319,23 @@ LocalizerEstimate Localizer::Step(const cv::Mat& live_image_raw,
     // back exactly on the state manifold.
     estimate.world_from_cam = WorldFromCamOfBase(estimate.base,
                                                  *base_from_cam_);
+  }
+
+  if (options_.method == LocalizationMethod::kMcc && options_.refine_estimate) {
+    const Timer refine_timer;
+    const cv::Mat live_large = LiveImagePreparer::Downscale(
+        undistorted, refiner_.options().width, refiner_.options().height);
+    const MccResult r = refiner_.Correct(live_large, estimate.world_from_cam);
+    if (r.accepted) {
+      estimate.world_from_cam = r.world_from_cam;
+      if (planar) {
+        estimate.base = BaseOfWorldFromCam(r.world_from_cam, *base_from_cam_);
+        estimate.world_from_cam =
+            WorldFromCamOfBase(estimate.base, *base_from_cam_);
+      }
+      stats.refined = true;
+    }
+    stats.mcc_seconds += refine_timer.ElapsedSeconds();
   }
 
   // Augmented MCL: long- and short-term averages of the likelihood.

@@ -50,6 +50,21 @@ struct LocalizerOptions {
   MccOptions mcc;
   // MCC: how many of the heaviest particles are corrected per step.
   int mcc_top_k = 8;
+  // MCC: the estimate of each update is corrected once more against a
+  // render of refine_mcc's (larger) size; only the output changes, not the
+  // particles. The particle corrections run small for speed, and at
+  // 160x120 a pixel is ~0.6 degrees of view.
+  bool refine_estimate = true;
+  // Options of that refinement: its width is the largest used (the live
+  // camera's size is kept if smaller), its height follows the camera's
+  // aspect.
+  MccOptions refine_mcc = [] {
+    MccOptions o;
+    o.width = 1024;
+    o.height = 768;
+    o.klt_window = 21;
+    return o;
+  }();
   // MCC: particles closer than this after resampling are merged (m, deg).
   double merge_translation_m = 0.005;
   double merge_rotation_deg = 0.5;
@@ -104,9 +119,10 @@ struct LocalizerStepStats {
   int mcc_attempted = 0;
   int mcc_accepted = 0;
   int merged = 0;
+  bool refined = false;      // the estimate was refined (refine_estimate)
   bool resampled = false;
   double weigh_seconds = 0.0;  // rendering + NCC of every particle
-  double mcc_seconds = 0.0;    // corrections (MCC only)
+  double mcc_seconds = 0.0;    // corrections (MCC only), refinement included
   double seconds = 0.0;        // the whole step
 };
 
@@ -156,6 +172,7 @@ class Localizer {
   Renderer renderer_;
   MeasurementModel measurement_;
   MonteCarloCorrector corrector_;
+  MonteCarloCorrector refiner_;
   Eigen::Vector2d area_min_, area_max_;
   std::vector<Particle> particles_;
   Rigid3d global_reference_;

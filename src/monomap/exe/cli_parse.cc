@@ -1,0 +1,22 @@
+#include "monomap/exe/cli_parse.h"
+
+#include <cstdio>
+
+#include "monomap/util/error.h"
+
+namespace monomap {
+
+void ParseImageSize(const std::string& text, const std::string& option,
+                    int* width, int* height) {
+  int w = 0, h = 0;
+  char x = 0, extra = 0;
+  if (std::sscanf(text.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 ||
+      x != 'x' || w <= 0 || h <= 0 || w > 16384 || h > 16384) {
+    throw OptionsError(option + ": expected WxH like 160x120, got '" + text +
+                       "'");
+  }
+  *width = w;
+  *height = h;
+}
+
+}  // namespace monomap
