@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -117,6 +118,72 @@ TEST_F(Cli, MissingDatasetIsNamed) {
   const RunResult r = RunMonomap("build /nonexistent/ds -o /tmp/x -q");
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.output.find("/nonexistent/ds"), std::string::npos);
+}
+
+TEST_F(Cli, EvalStructurePrintsTheTableAndWritesJson) {
+  const fs::path data = *root_ / "data";
+  const fs::path map = *root_ / "map_structure";
+  RunResult r = RunMonomap("build " + data.string() + " -o " + map.string() +
+                           " -q");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const fs::path json = *root_ / "structure.json";
+  r = RunMonomap("eval structure " + map.string() + " --structure " +
+                 (data / "structure").string() + " --json " + json.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("structure accuracy (alignment none)"),
+            std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("plane precision"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("on planes rel (%)"), std::string::npos)
+      << r.output;
+  std::ifstream in(json);
+  const std::string text((std::istreambuf_iterator<char>(in)),
+                         std::istreambuf_iterator<char>());
+  for (const char* key :
+       {"\"counts\"", "\"point_error\"", "\"planes\"", "\"true_planes\"",
+        "\"precision\"", "\"recall\"", "\"alignment\": \"none\""}) {
+    EXPECT_NE(text.find(key), std::string::npos) << key << "\n" << text;
+  }
+  // Relative errors use the depths from features.csv, not 0.
+  EXPECT_NE(text.find("mean_distance_to_observing_cameras"),
+            std::string::npos);
+
+  r = RunMonomap("eval structure " + map.string() + " --structure " +
+                 (data / "structure").string() +
+                 " --align first-pose --groundtruth " +
+                 (data / "groundtruth.txt").string());
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("(alignment first-pose)"), std::string::npos)
+      << r.output;
+}
+
+TEST_F(Cli, EvalStructureErrorsNameThePath) {
+  const fs::path data = *root_ / "data";
+  // A missing map or structure directory: exit 1, the path named.
+  RunResult r = RunMonomap("eval structure /nonexistent/map --structure " +
+                           (data / "structure").string());
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("/nonexistent/map"), std::string::npos)
+      << r.output;
+  r = RunMonomap("eval structure " + (data / "structure").string() +
+                 " --structure /nonexistent/structure");
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("/nonexistent/structure"), std::string::npos)
+      << r.output;
+  // Usage errors exit with 2.
+  r = RunMonomap("eval structure " + (data / "structure").string() +
+                 " --structure " + (data / "structure").string() +
+                 " --align first-pose");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--groundtruth"), std::string::npos) << r.output;
+  EXPECT_EQ(RunMonomap("eval structure " + (data / "structure").string() +
+                       " --structure " + (data / "structure").string() +
+                       " --align sim3")
+                .exit_code,
+            2);
+  EXPECT_EQ(RunMonomap("eval structure " + (data / "structure").string())
+                .exit_code,
+            2);
 }
 
 }  // namespace

@@ -21,6 +21,47 @@ nlohmann::json ToJson(const TrajectoryErrors& e) {
           {"rotation_deg", ToJson(e.rotation_deg)}};
 }
 
+nlohmann::json ToJson(const StructureAccuracy& a) {
+  nlohmann::json matches = nlohmann::json::array();
+  for (const PlaneMatch& m : a.matches) {
+    matches.push_back({{"fitted_id", m.fitted_id},
+                       {"inliers", m.inliers},
+                       {"true_id", m.true_id},
+                       {"normal_error_deg", m.normal_error_deg},
+                       {"offset_error_m", m.offset_error_m},
+                       {"matched", m.matched}});
+  }
+  nlohmann::json true_planes = nlohmann::json::array();
+  for (const TruePlaneResult& t : a.true_plane_results) {
+    const bool compared = t.best_fitted_id >= 0;
+    true_planes.push_back(
+        {{"true_id", t.true_id},
+         {"near_landmarks", t.near_landmarks},
+         {"observed", t.observed},
+         {"matched", t.matched},
+         {"best_fitted_id", t.best_fitted_id},
+         {"normal_error_deg",
+          compared ? nlohmann::json(t.normal_error_deg) : nlohmann::json()},
+         {"offset_error_m",
+          compared ? nlohmann::json(t.offset_error_m) : nlohmann::json()}});
+  }
+  nlohmann::json j;
+  j["counts"] = {{"true_planes", a.true_planes},
+                 {"observed_true_planes", a.observed_true_planes},
+                 {"fitted_planes", a.fitted_planes},
+                 {"landmarks", a.landmarks},
+                 {"landmarks_off_structure", a.landmarks_off_structure}};
+  j["point_error"] = {{"all_landmarks", ToJson(a.point_error_all)},
+                      {"landmarks_on_planes", ToJson(a.point_error_on_planes)}};
+  j["planes"] = {{"matches", matches},
+                 {"normal_error_deg", ToJson(a.normal_error_deg)},
+                 {"offset_error_m", ToJson(a.offset_error_m)},
+                 {"precision", a.precision},
+                 {"recall", a.recall}};
+  j["true_planes"] = true_planes;
+  return j;
+}
+
 namespace {
 
 std::string Header() {
@@ -53,6 +94,56 @@ std::string FormatTable(const TrajectoryErrors& e) {
                 e.scale);
   return buf + Header() + Row("translation (mm)", e.translation_m, 1e3) +
          Row("rotation (deg)", e.rotation_deg, 1.0);
+}
+
+std::string FormatTable(const StructureAccuracy& a) {
+  int matched_fitted = 0, matched_observed = 0;
+  for (const PlaneMatch& m : a.matches) matched_fitted += m.matched;
+  for (const TruePlaneResult& t : a.true_plane_results) {
+    matched_observed += t.observed && t.matched;
+  }
+  char buf[256];
+  std::snprintf(buf, sizeof(buf),
+                "%d true planes (%d observed), %d fitted planes; %d "
+                "landmarks, %d on no true plane\n"
+                "plane precision %.1f%% (%d of %d fitted planes match), "
+                "recall %.1f%% (%d of %d observed true planes found)\n",
+                a.true_planes, a.observed_true_planes, a.fitted_planes,
+                a.landmarks, a.landmarks_off_structure, 100 * a.precision,
+                matched_fitted, a.fitted_planes, 100 * a.recall,
+                matched_observed, a.observed_true_planes);
+  std::string out = buf;
+  out += Header() + Row("all abs (mm)", a.point_error_all.absolute_m, 1e3) +
+         Row("all rel (%)", a.point_error_all.relative_percent, 1.0) +
+         Row("on planes abs (mm)", a.point_error_on_planes.absolute_m, 1e3) +
+         Row("on planes rel (%)", a.point_error_on_planes.relative_percent,
+             1.0) +
+         Row("normal error (deg)", a.normal_error_deg, 1.0) +
+         Row("offset error (mm)", a.offset_error_m, 1e3);
+  out += "fitted  inliers  true  normal(deg)  offset(mm)  match\n";
+  for (const PlaneMatch& m : a.matches) {
+    std::snprintf(buf, sizeof(buf), "%6d  %7d  %4d  %11.3f  %10.2f  %5s\n",
+                  m.fitted_id, m.inliers, m.true_id, m.normal_error_deg,
+                  m.offset_error_m * 1e3, m.matched ? "yes" : "no");
+    out += buf;
+  }
+  out += "  true  landmarks  observed  matched  best fitted  normal(deg)  "
+         "offset(mm)\n";
+  for (const TruePlaneResult& t : a.true_plane_results) {
+    if (t.best_fitted_id >= 0) {
+      std::snprintf(buf, sizeof(buf),
+                    "%6d  %9d  %8s  %7s  %11d  %11.3f  %10.2f\n", t.true_id,
+                    t.near_landmarks, t.observed ? "yes" : "no",
+                    t.matched ? "yes" : "no", t.best_fitted_id,
+                    t.normal_error_deg, t.offset_error_m * 1e3);
+    } else {
+      std::snprintf(buf, sizeof(buf), "%6d  %9d  %8s  %7s  %11s  %11s  %10s\n",
+                    t.true_id, t.near_landmarks, t.observed ? "yes" : "no",
+                    "no", "-", "-", "-");
+    }
+    out += buf;
+  }
+  return out;
 }
 
 }  // namespace monomap

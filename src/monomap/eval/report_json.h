@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "monomap/eval/point_accuracy.h"
+#include "monomap/eval/structure_accuracy.h"
 #include "monomap/eval/trajectory_metrics.h"
 
 namespace monomap {
@@ -17,11 +18,26 @@ nlohmann::json ToJson(const ErrorStats& stats);
 nlohmann::json ToJson(const PointAccuracy& accuracy);
 // {"matched": n, "scale": s, "translation_m": {...}, "rotation_deg": {...}}
 nlohmann::json ToJson(const TrajectoryErrors& errors);
+// {"counts": {true_planes, observed_true_planes, fitted_planes, landmarks,
+//             landmarks_off_structure},
+//  "point_error": {"all_landmarks": {...}, "landmarks_on_planes": {...}},
+//  "planes": {"matches": [{fitted_id, inliers, true_id, normal_error_deg,
+//                          offset_error_m, matched}],
+//             "normal_error_deg": {...}, "offset_error_m": {...},
+//             "precision": p, "recall": r},
+//  "true_planes": [{true_id, near_landmarks, observed, matched,
+//                   best_fitted_id, normal_error_deg, offset_error_m}]}
+// (errors of a true plane without a fitted plane are null).
+nlohmann::json ToJson(const StructureAccuracy& accuracy);
 
 // Fixed-width tables, one row per quantity, columns count mean median p90
 // max rms; each ends with a newline. Point errors in mm and %.
 std::string FormatTable(const PointAccuracy& accuracy);
 // Translation in mm, rotation in degrees, plus the matched count and scale.
 std::string FormatTable(const TrajectoryErrors& errors);
+// Counts, precision and recall, point errors (mm and %), then one row per
+// fitted plane and one per true plane (normal errors in degrees, offsets
+// in mm).
+std::string FormatTable(const StructureAccuracy& accuracy);
 
 }  // namespace monomap

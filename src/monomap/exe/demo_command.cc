@@ -37,7 +37,8 @@ void RegisterDemoCommand(CLI::App& app) {
     o->output_dir = args->output;
     o->show_progress = !args->quiet;
     const DemoReport r = RunDemo(*o);
-    const auto& pe = r.point_error_on_planes.absolute_m;
+    const StructureAccuracy& st = r.structure;
+    const auto& pe = st.point_error_on_planes.absolute_m;
     std::printf(
         "monomap demo: %d frames, %d landmarks, %d planes found (%d true "
         "planes observed, recall %.0f%%, precision %.0f%%)\n"
@@ -46,9 +47,9 @@ void RegisterDemoCommand(CLI::App& app) {
         "  ATE (first-pose aligned, rms): refined %.1f cm, odometry %.1f cm\n"
         "  total %.1f s\n"
         "report: %s\n",
-        r.frames, r.landmarks, r.fitted_planes, r.observed_true_planes,
-        100 * r.plane_recall, 100 * r.plane_precision, pe.median * 1000,
-        pe.p90 * 1000, r.point_error_on_planes.relative_percent.median,
+        r.frames, r.landmarks, st.fitted_planes, st.observed_true_planes,
+        100 * st.recall, 100 * st.precision, pe.median * 1000, pe.p90 * 1000,
+        st.point_error_on_planes.relative_percent.median,
         r.ate_refined.translation_m.rms * 100,
         r.ate_odometry.translation_m.rms * 100, r.total_seconds,
         r.report_html.string().c_str());

@@ -1,14 +1,21 @@
 // monomap eval points MAP_DIR (--plane STRUCTURE.yaml | --surface CLOUD.ply)
+// monomap eval planes MAP_DIR (--plane STRUCTURE.yaml | --surface CLOUD.ply)
+// monomap eval checkerboard MAP_DIR --structure STRUCTURE.yaml
+// monomap eval structure MAP_DIR --structure STRUCTURE_DIR
+//     [--align none|first-pose --groundtruth GT.txt]
 // monomap eval trajectory ESTIMATE.txt GROUNDTRUTH.txt [--align ...]
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <memory>
 
 #include "monomap/eval/checkerboard_accuracy.h"
 #include "monomap/eval/point_accuracy.h"
 #include "monomap/eval/report_json.h"
+#include "monomap/eval/structure_accuracy.h"
 #include "monomap/eval/trajectory_metrics.h"
 #include "monomap/exe/commands.h"
+#include "monomap/io/feature_table.h"
 #include "monomap/io/map_format.h"
 #include "monomap/io/ply.h"
 #include "monomap/io/trajectory_io.h"
@@ -206,6 +213,86 @@ void RegisterEvalCommand(CLI::App& app) {
                   acc.error_m.max * 1e3);
     PrintOrWrite(j, table, ba->json);
     if (!acc.found) throw StageError("checkerboard not found in any texture");
+  });
+
+  struct StructureArgs {
+    std::string map_dir, structure_dir, align = "none", groundtruth, json;
+    StructureAccuracyOptions options;  // the project's matching thresholds
+  };
+  auto sa = std::make_shared<StructureArgs>();
+  CLI::App* structure = eval->add_subcommand(
+      "structure",
+      "Compare the map with a world's true planes (a simulated dataset's "
+      "structure/ directory): point errors, plane matches, precision and "
+      "recall");
+  structure->add_option("map", sa->map_dir, "Map directory")->required();
+  structure
+      ->add_option("--structure", sa->structure_dir,
+                   "Ground-truth structure as a map directory (the "
+                   "simulator writes DATASET/structure)")
+      ->required();
+  structure
+      ->add_option("--align", sa->align,
+                   "none: the map is in the truth's frame (the simulator's "
+                   "odometry starts at the true pose); first-pose: align "
+                   "the map's first trajectory pose to --groundtruth")
+      ->check(CLI::IsMember({"none", "first-pose"}))
+      ->capture_default_str();
+  structure->add_option("--groundtruth", sa->groundtruth,
+                        "Ground-truth trajectory (TUM) for --align "
+                        "first-pose");
+  structure->add_option("--json", sa->json, "Write the figures as JSON");
+  structure->callback([sa]() {
+    const bool first_pose = sa->align == "first-pose";
+    if (first_pose && sa->groundtruth.empty()) {
+      throw OptionsError("eval structure: --align first-pose needs "
+                         "--groundtruth");
+    }
+    if (!first_pose && !sa->groundtruth.empty()) {
+      throw OptionsError("eval structure: --groundtruth is only used with "
+                         "--align first-pose");
+    }
+    Map map = ReadMap(sa->map_dir);
+    const Map truth = ReadMap(sa->structure_dir);
+    // Relative point errors divide by each landmark's mean depth, which
+    // points.ply does not hold: recompute it from the feature table.
+    const std::filesystem::path features =
+        std::filesystem::path(sa->map_dir) / "features.csv";
+    const bool have_features = std::filesystem::is_regular_file(features);
+    if (!have_features) {
+      std::fprintf(stderr,
+                   "monomap: note: %s missing: relative point errors use "
+                   "the distance to the nearest camera\n",
+                   features.string().c_str());
+    }
+    SetLandmarkDepths(have_features ? ReadFeatureTable(features)
+                                    : std::vector<Track>(),
+                      &map);
+    Rigid3d truth_from_map;
+    if (first_pose) {
+      truth_from_map =
+          AlignTrajectories(map.trajectory,
+                            ReadTumTrajectory(sa->groundtruth),
+                            Alignment::kFirstPose)
+              .rigid;
+    }
+    const StructureAccuracy acc =
+        EvaluateStructure(map, truth, truth_from_map, sa->options);
+    nlohmann::json j = ToJson(acc);
+    j["alignment"] = sa->align;
+    j["relative_error_depth"] =
+        have_features ? "mean_distance_to_observing_cameras"
+                      : "distance_to_nearest_camera";
+    j["options"] = {
+        {"max_match_angle_deg", sa->options.max_match_angle_deg},
+        {"max_match_offset_m", sa->options.max_match_offset_m},
+        {"polygon_margin_m", sa->options.polygon_margin_m},
+        {"min_observed_landmarks", sa->options.min_observed_landmarks},
+        {"observed_distance_m", sa->options.observed_distance_m}};
+    PrintOrWrite(j,
+                 "structure accuracy (alignment " + sa->align + ")\n" +
+                     FormatTable(acc),
+                 sa->json);
   });
 
   struct TrajArgs {

@@ -33,23 +33,12 @@ void DemoOptions::Check() const {
               "must be at least 20 (the map needs motion)");
   CheckOption(width >= 64 && height >= 48, "width/height",
               "must be at least 64x48");
-  CheckOption(max_match_angle_deg > 0, "max_match_angle_deg",
-              "must be positive");
-  CheckOption(max_match_offset_m > 0, "max_match_offset_m",
-              "must be positive");
-  CheckOption(polygon_margin_m >= 0, "polygon_margin_m",
-              "must not be negative");
-  CheckOption(min_observed_landmarks >= 1, "min_observed_landmarks",
-              "must be at least 1");
-  CheckOption(observed_distance_m > 0, "observed_distance_m",
-              "must be positive");
+  structure.Check();
   CheckOption(rpe_delta_frames >= 1, "rpe_delta_frames",
               "must be at least 1");
 }
 
 namespace {
-
-constexpr double kRadToDeg = 180.0 / M_PI;
 
 // ---------------------------------------------------------------------------
 // Small HTML / SVG helpers.
@@ -311,46 +300,6 @@ class SvgPlot {
 // ---------------------------------------------------------------------------
 // Evaluation helpers.
 
-// Distance from p to the boundary of a polygon (0 for < 2 vertices).
-double DistanceToPolygonBoundary(const Polygon2d& polygon,
-                                 const Eigen::Vector2d& p) {
-  double best = std::numeric_limits<double>::infinity();
-  for (size_t i = 0; i < polygon.size(); ++i) {
-    const Eigen::Vector2d& a = polygon[i];
-    const Eigen::Vector2d& b = polygon[(i + 1) % polygon.size()];
-    const Eigen::Vector2d ab = b - a;
-    const double len2 = ab.squaredNorm();
-    const double t =
-        len2 > 0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
-    best = std::min(best, (a + t * ab - p).norm());
-  }
-  return polygon.size() < 2 ? 0.0 : best;
-}
-
-// A landmark's nearest true plane among those containing its projection.
-struct Assignment {
-  int true_index = -1;
-  double distance_m = 0.0;
-};
-
-Assignment AssignToTruth(const std::vector<TexturedPlane>& truth,
-                         const Eigen::Vector3d& x, double margin_m) {
-  Assignment best;
-  best.distance_m = std::numeric_limits<double>::infinity();
-  for (size_t j = 0; j < truth.size(); ++j) {
-    const TexturedPlane& p = truth[j];
-    const double d = std::abs(p.plane.SignedDistance(x));
-    if (d >= best.distance_m) continue;
-    const Eigen::Vector2d st = p.frame.ToPlane(x);
-    const bool inside = p.polygon.size() < 3 ||
-                        PointInPolygon(p.polygon, st) ||
-                        DistanceToPolygonBoundary(p.polygon, st) <= margin_m;
-    if (inside) best = {static_cast<int>(j), d};
-  }
-  if (best.true_index < 0) best.distance_m = 0.0;
-  return best;
-}
-
 std::vector<TimedPose> AlignedPoses(const std::vector<TimedPose>& poses,
                                     const Sim3d& align) {
   std::vector<TimedPose> out = poses;
@@ -481,30 +430,16 @@ nlohmann::json DemoReport::ToJson() const {
                 {"report_json", report_json.string()},
                 {"dataset", dataset_dir.string()},
                 {"map", map_dir.string()}};
-  j["counts"] = {{"frames", frames},
-                 {"tracks", tracks},
-                 {"landmarks", landmarks},
-                 {"true_planes", true_planes},
-                 {"observed_true_planes", observed_true_planes},
-                 {"fitted_planes", fitted_planes},
-                 {"landmarks_off_structure", landmarks_off_structure}};
-  j["point_error"] = {{"all_landmarks", monomap::ToJson(point_error_all)},
-                      {"landmarks_on_planes",
-                       monomap::ToJson(point_error_on_planes)}};
-  nlohmann::json matches = nlohmann::json::array();
-  for (const auto& m : plane_matches) {
-    matches.push_back({{"fitted_id", m.fitted_id},
-                       {"inliers", m.inliers},
-                       {"true_id", m.true_id},
-                       {"normal_error_deg", m.normal_error_deg},
-                       {"offset_error_m", m.offset_error_m},
-                       {"matched", m.matched}});
-  }
-  j["planes"] = {{"matches", matches},
-                 {"normal_error_deg", monomap::ToJson(plane_normal_error_deg)},
-                 {"offset_error_m", monomap::ToJson(plane_offset_error_m)},
-                 {"precision", plane_precision},
-                 {"recall", plane_recall}};
+  // The structure figures under the keys report.json has always had
+  // (counts, point_error, planes); the per-true-plane list of the eval
+  // JSON is not part of it.
+  const nlohmann::json s = monomap::ToJson(structure);
+  j["counts"] = s["counts"];
+  j["counts"]["frames"] = frames;
+  j["counts"]["tracks"] = tracks;
+  j["counts"]["landmarks"] = landmarks;
+  j["point_error"] = s["point_error"];
+  j["planes"] = s["planes"];
   j["trajectory"] = {{"alignment", "first_pose"},
                      {"ate_refined", monomap::ToJson(ate_refined)},
                      {"ate_odometry", monomap::ToJson(ate_odometry)},
@@ -577,7 +512,6 @@ DemoReport RunDemo(const DemoOptions& options) {
   report.frames = static_cast<int>(dataset.frames.size());
   report.tracks = static_cast<int>(result.tracks.size());
   report.landmarks = static_cast<int>(map.landmarks.size());
-  report.fitted_planes = static_cast<int>(map.planes.size());
 
   // 3. Evaluate. The map lives in the odometry frame; both odometry and
   // ground truth start at the same pose, and the first-pose alignment of the
@@ -585,112 +519,15 @@ DemoReport RunDemo(const DemoOptions& options) {
   say("evaluating against the ground truth");
   const Timer eval_timer;
   const Map truth = ReadMap(report.dataset_dir / "structure");
-  report.true_planes = static_cast<int>(truth.planes.size());
   const Sim3d world_from_map =
       AlignTrajectories(odometry, groundtruth, Alignment::kFirstPose);
 
-  // 3a. Points.
-  std::vector<Assignment> assignment(map.landmarks.size());
-  std::vector<double> abs_all, rel_all, abs_on, rel_on;
-  std::vector<int> near_count(truth.planes.size(), 0);
-  for (size_t i = 0; i < map.landmarks.size(); ++i) {
-    const Landmark& l = map.landmarks[i];
-    const Eigen::Vector3d x = world_from_map.rigid * l.x_in_world;
-    assignment[i] = AssignToTruth(truth.planes, x, options.polygon_margin_m);
-    const Assignment& a = assignment[i];
-    if (a.true_index < 0) {
-      ++report.landmarks_off_structure;
-      continue;
-    }
-    if (a.distance_m <= options.observed_distance_m) {
-      ++near_count[a.true_index];
-    }
-    const double rel =
-        l.mean_depth_m > 0 ? a.distance_m / l.mean_depth_m * 100.0 : 0.0;
-    abs_all.push_back(a.distance_m);
-    rel_all.push_back(rel);
-    if (l.plane_id >= 0) {
-      abs_on.push_back(a.distance_m);
-      rel_on.push_back(rel);
-    }
-  }
-  report.point_error_all = {ComputeErrorStats(abs_all),
-                            ComputeErrorStats(rel_all)};
-  report.point_error_on_planes = {ComputeErrorStats(abs_on),
-                                  ComputeErrorStats(rel_on)};
+  // 3a. Points and planes.
+  report.structure =
+      EvaluateStructure(map, truth, world_from_map.rigid, options.structure);
+  const StructureAccuracy& structure = report.structure;
 
-  // 3b. Planes: each fitted plane is compared with the true plane most of
-  // its inliers lie on (coplanar true planes are told apart by extent).
-  std::vector<bool> true_matched(truth.planes.size(), false);
-  std::vector<double> normal_errors, offset_errors;
-  int matched_fitted = 0;
-  for (const TexturedPlane& fitted : map.planes) {
-    DemoPlaneMatch m;
-    m.fitted_id = fitted.id;
-    std::vector<int> votes(truth.planes.size(), 0);
-    for (size_t i = 0; i < map.landmarks.size(); ++i) {
-      if (map.landmarks[i].plane_id != fitted.id) continue;
-      ++m.inliers;
-      if (assignment[i].true_index >= 0) ++votes[assignment[i].true_index];
-    }
-    const Plane plane = fitted.plane.Transformed(world_from_map.rigid);
-    auto compare = [&](size_t j, double* angle_deg, double* offset_m) {
-      const Plane& t = truth.planes[j].plane;
-      const double sign = plane.normal.dot(t.normal) < 0 ? -1.0 : 1.0;
-      *angle_deg =
-          std::acos(std::clamp(sign * plane.normal.dot(t.normal), -1.0, 1.0)) *
-          kRadToDeg;
-      *offset_m = std::abs(sign * plane.offset - t.offset);
-    };
-    int best = -1;
-    for (size_t j = 0; j < votes.size(); ++j) {
-      if (votes[j] > 0 && (best < 0 || votes[j] > votes[best])) {
-        best = static_cast<int>(j);
-      }
-    }
-    if (best < 0) {  // no inlier on the structure: take the closest plane
-      double best_cost = std::numeric_limits<double>::infinity();
-      for (size_t j = 0; j < truth.planes.size(); ++j) {
-        double a, o;
-        compare(j, &a, &o);
-        const double cost = a / options.max_match_angle_deg +
-                            o / options.max_match_offset_m;
-        if (cost < best_cost) best_cost = cost, best = static_cast<int>(j);
-      }
-    }
-    if (best >= 0) {
-      m.true_id = truth.planes[best].id;
-      compare(best, &m.normal_error_deg, &m.offset_error_m);
-      m.matched = m.normal_error_deg <= options.max_match_angle_deg &&
-                  m.offset_error_m <= options.max_match_offset_m;
-      normal_errors.push_back(m.normal_error_deg);
-      offset_errors.push_back(m.offset_error_m);
-      if (m.matched) {
-        ++matched_fitted;
-        true_matched[best] = true;
-      }
-    }
-    report.plane_matches.push_back(m);
-  }
-  report.plane_normal_error_deg = ComputeErrorStats(normal_errors);
-  report.plane_offset_error_m = ComputeErrorStats(offset_errors);
-  int observed_matched = 0;
-  for (size_t j = 0; j < truth.planes.size(); ++j) {
-    if (near_count[j] >= options.min_observed_landmarks) {
-      ++report.observed_true_planes;
-      if (true_matched[j]) ++observed_matched;
-    }
-  }
-  report.plane_precision =
-      map.planes.empty() ? 0.0
-                         : static_cast<double>(matched_fitted) /
-                               static_cast<double>(map.planes.size());
-  report.plane_recall = report.observed_true_planes == 0
-                            ? 0.0
-                            : static_cast<double>(observed_matched) /
-                                  report.observed_true_planes;
-
-  // 3c. Trajectories.
+  // 3b. Trajectories.
   report.ate_refined = AbsoluteTrajectoryError(map.trajectory, groundtruth,
                                                Alignment::kFirstPose);
   report.ate_odometry =
@@ -723,15 +560,15 @@ DemoReport RunDemo(const DemoOptions& options) {
     << HtmlEscape(report.dataset_dir.string()) << "</code>, map: <code>"
     << HtmlEscape(report.map_dir.string()) << "</code>.</p>\n";
 
-  const PointAccuracy& pe = report.point_error_on_planes;
+  const PointAccuracy& pe = structure.point_error_on_planes;
   h << "<div class=\"cards\">"
     << "<div class=\"card\">landmarks<b>" << report.landmarks << "</b></div>"
     << "<div class=\"card\">planes found / observed<b>"
-    << report.fitted_planes << " / " << report.observed_true_planes
+    << structure.fitted_planes << " / " << structure.observed_true_planes
     << "</b></div>"
     << "<div class=\"card\">plane recall / precision<b>"
-    << Fmt("%.0f%%", 100 * report.plane_recall) << " / "
-    << Fmt("%.0f%%", 100 * report.plane_precision) << "</b></div>"
+    << Fmt("%.0f%%", 100 * structure.recall) << " / "
+    << Fmt("%.0f%%", 100 * structure.precision) << "</b></div>"
     << "<div class=\"card\">median point error (on planes)<b>"
     << Fmt("%.1f mm", pe.absolute_m.median * 1000) << " · "
     << Fmt("%.2f%%", pe.relative_percent.median) << "</b></div>"
@@ -871,8 +708,8 @@ DemoReport RunDemo(const DemoOptions& options) {
                  cv::Size(512, std::max(1, cvRound(tex.rows * s))), 0, 0,
                  cv::INTER_AREA);
     }
-    const DemoPlaneMatch* m = nullptr;
-    for (const auto& pm : report.plane_matches) {
+    const PlaneMatch* m = nullptr;
+    for (const auto& pm : structure.matches) {
       if (pm.fitted_id == p.id) m = &pm;
     }
     h << "<figure><div class=\"tex\" style=\"display:inline-block\">"
@@ -941,32 +778,33 @@ DemoReport RunDemo(const DemoOptions& options) {
   h << "<h2 id=\"accuracy\">Accuracy</h2>\n<h3>Points</h3>\n"
     << "<p class=\"note\">Distance of each landmark to the nearest true "
        "plane containing its projection; relative = distance / mean depth. "
-    << report.landmarks_off_structure
+    << structure.landmarks_off_structure
     << " landmarks project onto no true plane and are not counted.</p>\n"
     << "<table>" << kStatsHeader
-    << StatsRow("all landmarks (mm)", report.point_error_all.absolute_m,
+    << StatsRow("all landmarks (mm)", structure.point_error_all.absolute_m,
                 1000, "%.1f")
-    << StatsRow("all landmarks (%)", report.point_error_all.relative_percent,
-                1, "%.2f")
+    << StatsRow("all landmarks (%)",
+                structure.point_error_all.relative_percent, 1, "%.2f")
     << StatsRow("on a fitted plane (mm)",
-                report.point_error_on_planes.absolute_m, 1000, "%.1f")
+                structure.point_error_on_planes.absolute_m, 1000, "%.1f")
     << StatsRow("on a fitted plane (%)",
-                report.point_error_on_planes.relative_percent, 1, "%.2f")
+                structure.point_error_on_planes.relative_percent, 1, "%.2f")
     << "</table>\n";
   h << "<h3>Planes</h3>\n<p class=\"note\">A fitted plane matches a true "
        "plane if the normals differ by at most "
-    << Fmt("%g", options.max_match_angle_deg)
+    << Fmt("%g", options.structure.max_match_angle_deg)
     << "&deg; and the offsets by at most "
-    << Fmt("%g", options.max_match_offset_m * 100) << " cm. "
-    << report.true_planes << " true planes, " << report.observed_true_planes
-    << " observed (&ge; " << options.min_observed_landmarks
-    << " landmarks within " << Fmt("%g", options.observed_distance_m * 100)
-    << " cm). Recall " << Fmt("%.0f%%", 100 * report.plane_recall)
-    << ", precision " << Fmt("%.0f%%", 100 * report.plane_precision)
+    << Fmt("%g", options.structure.max_match_offset_m * 100) << " cm. "
+    << structure.true_planes << " true planes, "
+    << structure.observed_true_planes << " observed (&ge; "
+    << options.structure.min_observed_landmarks << " landmarks within "
+    << Fmt("%g", options.structure.observed_distance_m * 100)
+    << " cm). Recall " << Fmt("%.0f%%", 100 * structure.recall)
+    << ", precision " << Fmt("%.0f%%", 100 * structure.precision)
     << ".</p>\n<table><tr><th>fitted plane</th><th>points</th><th>true "
        "plane</th><th>normal error (&deg;)</th><th>offset error "
        "(mm)</th><th>match</th></tr>\n";
-  for (const auto& m : report.plane_matches) {
+  for (const auto& m : structure.matches) {
     h << "<tr><td><span style=\"color:" << LabelColor(m.fitted_id)
       << "\">&#9632;</span> " << m.fitted_id << "</td><td>" << m.inliers
       << "</td><td>" << m.true_id << "</td><td>"

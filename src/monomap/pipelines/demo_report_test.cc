@@ -32,7 +32,7 @@ TEST(DemoOptionsTest, RejectsBadValues) {
   o.num_frames = 5;
   EXPECT_THROW(o.Check(), OptionsError);
   o = DemoOptions();
-  o.max_match_angle_deg = 0;
+  o.structure.max_match_angle_deg = 0;
   EXPECT_THROW(o.Check(), OptionsError);
 }
 
@@ -53,14 +53,14 @@ TEST(DemoReportTest, SmallHallwayDemo) {
 
   EXPECT_EQ(r.frames, 60);
   EXPECT_GT(r.landmarks, 200);
-  EXPECT_GE(r.fitted_planes, 1);
-  EXPECT_GE(r.observed_true_planes, 1);
-  EXPECT_GT(r.plane_recall, 0.0);
-  EXPECT_GE(r.plane_precision, 0.5);
+  EXPECT_GE(r.structure.fitted_planes, 1);
+  EXPECT_GE(r.structure.observed_true_planes, 1);
+  EXPECT_GT(r.structure.recall, 0.0);
+  EXPECT_GE(r.structure.precision, 0.5);
   // Points on fitted planes lie on the true structure within centimetres.
-  EXPECT_GT(r.point_error_on_planes.absolute_m.count, 100u);
-  EXPECT_LT(r.point_error_on_planes.absolute_m.median, 0.03);
-  EXPECT_LT(r.point_error_on_planes.relative_percent.median, 3.0);
+  EXPECT_GT(r.structure.point_error_on_planes.absolute_m.count, 100u);
+  EXPECT_LT(r.structure.point_error_on_planes.absolute_m.median, 0.03);
+  EXPECT_LT(r.structure.point_error_on_planes.relative_percent.median, 3.0);
   // The refined trajectory is at least as good as odometry (small slack).
   EXPECT_EQ(r.ate_refined.matched, 60u);
   EXPECT_LT(r.ate_refined.translation_m.rms, 0.05);
@@ -72,9 +72,9 @@ TEST(DemoReportTest, SmallHallwayDemo) {
   const std::string html = ReadFileToString(r.report_html);
   // 3 track frames, 3 real + 3 rendered views, one texture per plane.
   EXPECT_EQ(CountOccurrences(html, "<img "),
-            static_cast<size_t>(9 + r.fitted_planes));
+            static_cast<size_t>(9 + r.structure.fitted_planes));
   EXPECT_EQ(CountOccurrences(html, "src=\"data:image/png;base64,"),
-            static_cast<size_t>(9 + r.fitted_planes));
+            static_cast<size_t>(9 + r.structure.fitted_planes));
   EXPECT_EQ(CountOccurrences(html, "src=\"http"), 0u);
   EXPECT_EQ(CountOccurrences(html, "href=\"http"), 0u);
   EXPECT_GE(CountOccurrences(html, "<svg "), 4u);
