@@ -22,14 +22,15 @@ void RegisterBuildCommand(CLI::App& app) {
     int ransac_iterations = 2000;
     int keyframe_interval = MappingOptions().keyframe_interval;
     int features = KltTrackerOptions().target_features;
+    bool no_affine = false;
+    int affine_interval = KltTrackerOptions().affine_interval;
     bool quiet = false;
     bool ba_verbose = false;
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
       "build", "Build a map (points, planes, textures) from a dataset");
-  cmd->add_option("dataset", args->dataset, "Dataset directory")
-      ->required();
+  cmd->add_option("dataset", args->dataset, "Dataset directory")->required();
   cmd->add_option("-o,--output", args->output, "Map directory to write")
       ->required();
   cmd->add_option("--report", args->report,
@@ -48,6 +49,13 @@ void RegisterBuildCommand(CLI::App& app) {
                   "Bundle-adjust every n-th frame (1: all frames)");
   cmd->add_option("--features", args->features,
                   "Features the tracker keeps alive per frame");
+  cmd->add_flag("--no-affine-refinement", args->no_affine,
+                "Track frame to frame only (no alignment with each "
+                "feature's reference patch)");
+  cmd->add_option("--affine-interval", args->affine_interval,
+                  "Align each feature with its reference patch every n-th "
+                  "frame (corrections in between interpolated)")
+      ->check(CLI::PositiveNumber);
   cmd->add_flag("-q,--quiet", args->quiet, "No progress output");
   cmd->add_flag("--ba-verbose", args->ba_verbose,
                 "Print the bundle adjustment solver's progress and report");
@@ -66,6 +74,8 @@ void RegisterBuildCommand(CLI::App& app) {
     options.planes.ransac_iterations = args->ransac_iterations;
     options.keyframe_interval = args->keyframe_interval;
     options.tracking.target_features = args->features;
+    options.tracking.affine_refinement = !args->no_affine;
+    options.tracking.affine_interval = args->affine_interval;
     options.show_progress = !args->quiet;
     const MappingResult result = BuildMap(dataset, options);
     WriteMappingResult(args->output, result);

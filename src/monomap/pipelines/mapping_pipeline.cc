@@ -254,6 +254,8 @@ nlohmann::json MappingReport::ToJson() const {
       {"tracks_created", tracking.tracks_created},
       {"mean_track_length", tracking.mean_track_length},
       {"mean_features_per_frame", tracking.mean_features_per_frame},
+      {"affine_refined", tracking.refined},
+      {"reference_patches_renewed", tracking.reanchored},
       {"seconds", tracking.seconds}};
   j["triangulation"] = {
       {"tracks_in", triangulation.num_tracks},

@@ -1,17 +1,18 @@
 #include "monomap/tracking/klt_tracker.h"
 
-#include <algorithm>
-#include <cmath>
-#include <string>
-#include <utility>
-
-#include <opencv2/imgproc.hpp>
-#include <opencv2/video/tracking.hpp>
 #include <tbb/blocked_range.h>
 #include <tbb/concurrent_queue.h>
 #include <tbb/info.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_pipeline.h>
+
+#include <Eigen/SVD>
+#include <algorithm>
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/video/tracking.hpp>
+#include <string>
+#include <utility>
 
 #include "monomap/util/error.h"
 #include "monomap/util/progress.h"
@@ -38,6 +39,9 @@ void KltTrackerOptions::Check() const {
   CheckOption(border_margin_px >= 0.0, "border_margin_px", "must be >= 0");
   CheckOption(grid_cols >= 1 && grid_rows >= 1, "grid_cols/grid_rows",
               "must be >= 1");
+  affine.Check();
+  CheckOption(affine_interval >= 1, "affine_interval", "must be >= 1");
+  CheckOption(max_affine_scale > 1.0, "max_affine_scale", "must be > 1");
 }
 
 namespace {
@@ -120,8 +124,8 @@ void KltTracker::Track(int frame_index, const cv::Mat& grey,
                      std::to_string(last_frame_) + ")");
   }
   if (last_frame_ >= 0 && grey.size() != size_) {
-    throw InputError(where + ": image size " + std::to_string(grey.cols) +
-                     "x" + std::to_string(grey.rows) +
+    throw InputError(where + ": image size " + std::to_string(grey.cols) + "x" +
+                     std::to_string(grey.rows) +
                      " differs from the first frame's");
   }
   if (pyramid.empty()) throw InputError(where + ": empty image pyramid");
@@ -137,8 +141,8 @@ void KltTracker::Track(int frame_index, const cv::Mat& grey,
     std::vector<cv::Point2f> next_pts;
     std::vector<uchar> status;
     std::vector<float> error;
-    ParallelPyrLk(prev_pyramid_, pyramid, prev_pts, &next_pts, &status,
-                  &error, options_);
+    ParallelPyrLk(prev_pyramid_, pyramid, prev_pts, &next_pts, &status, &error,
+                  options_);
 
     // Backward only for the features that survived the forward track.
     std::vector<size_t> forward_ok;
@@ -172,7 +176,7 @@ void KltTracker::Track(int frame_index, const cv::Mat& grey,
     std::vector<Active> kept;
     kept.reserve(active_.size());
     for (size_t k = 0; k < forward_ok.size(); ++k) {
-      const Active& a = active_[forward_ok[k]];
+      Active& a = active_[forward_ok[k]];
       const cv::Point2f p = fwd_pts[k];
       if (!back_status[k]) {
         ++stats.lost_lk;
@@ -188,11 +192,50 @@ void KltTracker::Track(int frame_index, const cv::Mat& grey,
         ++stats.lost_border;
         continue;
       }
-      kept.push_back({a.id, p});
-      tracks_[static_cast<size_t>(a.id)].observations.push_back(
-          {frame_index, Eigen::Vector2d(p.x, p.y)});
+      a.px = p;
+      kept.push_back(std::move(a));
     }
     active_ = std::move(kept);
+    if (options_.affine_refinement) {
+      const int interval = options_.affine_interval;
+      std::vector<char> refined(active_.size(), 0),
+          reanchored(active_.size(), 0);
+      std::vector<cv::Point2f> correction(active_.size());
+      tbb::parallel_for(tbb::blocked_range<size_t>(0, active_.size(), 32),
+                        [&](const tbb::blocked_range<size_t>& r) {
+                          for (size_t i = r.begin(); i != r.end(); ++i) {
+                            Active& f = active_[i];
+                            if ((frame_index + f.id) % interval != 0) continue;
+                            const cv::Point2f before = f.px;
+                            bool ref = false, re = false;
+                            RefineFeature(grey, &f, &ref, &re);
+                            refined[i] = ref;
+                            reanchored[i] = re;
+                            correction[i] = f.px - before;
+                          }
+                        });
+      for (size_t i = 0; i < active_.size(); ++i) {
+        stats.refined += refined[i];
+        stats.reanchored += reanchored[i];
+        Active& f = active_[i];
+        if (refined[i]) {
+          // The frames since the last alignment drifted by a growing share
+          // of this correction.
+          const double span = frame_index - f.reference_frame;
+          auto& obs = tracks_[static_cast<size_t>(f.id)].observations;
+          for (auto o = obs.rbegin();
+               o != obs.rend() && o->frame > f.reference_frame; ++o) {
+            const double share = (o->frame - f.reference_frame) / span;
+            o->px += share * Eigen::Vector2d(correction[i].x, correction[i].y);
+          }
+        }
+        if (refined[i] || reanchored[i]) f.reference_frame = frame_index;
+      }
+    }
+    for (const Active& a : active_) {
+      tracks_[static_cast<size_t>(a.id)].observations.push_back(
+          {frame_index, Eigen::Vector2d(a.px.x, a.px.y)});
+    }
     stats.tracked = static_cast<int>(active_.size());
   }
 
@@ -210,6 +253,8 @@ void KltTracker::Track(int frame_index, const cv::Mat& grey,
   total_stats_.lost_forward_backward += stats.lost_forward_backward;
   total_stats_.lost_border += stats.lost_border;
   total_stats_.detected += stats.detected;
+  total_stats_.refined += stats.refined;
+  total_stats_.reanchored += stats.reanchored;
   total_stats_.total += stats.total;
 }
 
@@ -218,13 +263,13 @@ void KltTracker::Detect(int frame_index, const cv::Mat& grey,
   const int cols = options_.grid_cols;
   const int rows = options_.grid_rows;
   const int num_cells = cols * rows;
-  const int quota = std::max(1, (options_.target_features + num_cells - 1) /
-                                    num_cells);
+  const int quota =
+      std::max(1, (options_.target_features + num_cells - 1) / num_cells);
   auto cell_of = [&](const cv::Point2f& p) {
-    const int cx = std::clamp(static_cast<int>(p.x * cols / size_.width), 0,
-                              cols - 1);
-    const int cy = std::clamp(static_cast<int>(p.y * rows / size_.height), 0,
-                              rows - 1);
+    const int cx =
+        std::clamp(static_cast<int>(p.x * cols / size_.width), 0, cols - 1);
+    const int cy =
+        std::clamp(static_cast<int>(p.y * rows / size_.height), 0, rows - 1);
     return cy * cols + cx;
   };
   std::vector<int> count(num_cells, 0);
@@ -264,7 +309,15 @@ void KltTracker::Detect(int frame_index, const cv::Mat& grey,
   auto start = [&](size_t k) {
     taken[k] = true;
     const FeatureId id = next_id_++;
-    active_.push_back({id, corners[k]});
+    Active a;
+    a.id = id;
+    a.px = corners[k];
+    a.reference_frame = frame_index;
+    if (options_.affine_refinement) {
+      a.reference.Extract(grey, Eigen::Vector2f(corners[k].x, corners[k].y),
+                          options_.affine);
+    }
+    active_.push_back(std::move(a));
     monomap::Track track;
     track.id = id;
     track.observations.push_back(
@@ -285,6 +338,33 @@ void KltTracker::Detect(int frame_index, const cv::Mat& grey,
        ++k) {
     if (!taken[k]) start(k);
   }
+}
+
+void KltTracker::RefineFeature(const cv::Mat& grey, Active* f, bool* refined,
+                               bool* reanchored) const {
+  Eigen::Vector2f t(f->px.x, f->px.y);
+  Eigen::Matrix2f warp = f->warp;
+  bool keep_reference = false;
+  if (!f->reference.empty()) {
+    const AffineRefinement r =
+        f->reference.Refine(grey, &warp, &t, options_.affine);
+    if (r.accepted) {
+      *refined = true;
+      f->px = cv::Point2f(t.x(), t.y());
+      f->warp = warp;
+      const Eigen::JacobiSVD<Eigen::Matrix2f> svd(warp);
+      const float limit = static_cast<float>(options_.max_affine_scale);
+      keep_reference = svd.singularValues()(0) <= limit &&
+                       svd.singularValues()(1) >= 1.0f / limit;
+    }
+  }
+  if (keep_reference) return;
+  // A new reference where the feature is now (frame-to-frame position if
+  // the alignment failed).
+  *reanchored = true;
+  f->warp.setIdentity();
+  f->reference.Extract(grey, Eigen::Vector2f(f->px.x, f->px.y),
+                       options_.affine);
 }
 
 std::vector<KltFeature> KltTracker::Features() const {
@@ -351,7 +431,8 @@ TrackingReport TrackFeatures(const std::function<cv::Mat(int)>& load_grey,
                                    ": loader returned no 8-bit grey image");
                 }
                 std::vector<cv::Mat> recycled;
-                if (spares.try_pop(recycled)) item.pyramid = std::move(recycled);
+                if (spares.try_pop(recycled))
+                  item.pyramid = std::move(recycled);
                 KltTracker::BuildPyramid(item.grey, options, &item.pyramid);
                 return item;
               }) &
@@ -369,6 +450,8 @@ TrackingReport TrackFeatures(const std::function<cv::Mat(int)>& load_grey,
   report.lost_forward_backward = totals.lost_forward_backward;
   report.lost_lk = totals.lost_lk + totals.lost_error;
   report.lost_border = totals.lost_border;
+  report.refined = totals.refined;
+  report.reanchored = totals.reanchored;
   report.mean_features_per_frame =
       static_cast<double>(totals.total) / num_frames;
 

@@ -8,19 +8,22 @@
 // boundaries and on content that changed (a hand entering the view) instead
 // of letting them drift. Lost features are replaced by new corners detected
 // in the parts of the image that have too few, so the features stay spread
-// over the image. Output pixels are raw (distorted); the geometric stages
+// over the image. After the frame-to-frame step every feature is aligned
+// with its reference patch by an affine-photometric Lucas-Kanade
+// (feature_template.h), which keeps frame-to-frame errors from adding up
+// into drift. Output pixels are raw (distorted); the geometric stages
 // undistort them.
 #pragma once
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <functional>
+#include <opencv2/core.hpp>
 #include <utility>
 #include <vector>
 
-#include <Eigen/Core>
-#include <opencv2/core.hpp>
-
 #include "monomap/map/map.h"
+#include "monomap/tracking/feature_template.h"
 
 namespace monomap {
 
@@ -61,6 +64,20 @@ struct KltTrackerOptions {
   // the image rather than piled up in its most textured corner.
   int grid_cols = 6;
   int grid_rows = 4;
+  // Align each tracked feature with its reference patch (affine warp,
+  // normalized intensities) after the frame-to-frame step: no drift.
+  bool affine_refinement = true;
+  // Options of that alignment.
+  AffineRefinementOptions affine;
+  // A feature is aligned every n-th frame (staggered over the features, so
+  // every frame does 1/n of them); the frames in between get the
+  // correction interpolated, since drift grows smoothly. 1: every frame.
+  int affine_interval = 1;
+  // The reference patch is taken again from the current frame when the
+  // warp has scaled it by more than this factor in some direction (or
+  // less than its inverse), or when an alignment fails: a reference seen
+  // too differently no longer aligns well.
+  double max_affine_scale = 1.3;
 
   void Check() const;
 };
@@ -68,13 +85,15 @@ struct KltTrackerOptions {
 // Counts for one call of KltTracker::Track.
 struct KltFrameStats {
   int frame = 0;
-  int tracked = 0;          // features carried over from the previous frame
-  int lost_lk = 0;          // LK failed (status 0 or flat window)
-  int lost_error = 0;       // LK error above max_lk_error
+  int tracked = 0;     // features carried over from the previous frame
+  int lost_lk = 0;     // LK failed (status 0 or flat window)
+  int lost_error = 0;  // LK error above max_lk_error
   int lost_forward_backward = 0;  // forward-backward error too large
-  int lost_border = 0;      // left the image (or its margin)
-  int detected = 0;         // new features started in this frame
-  int total = 0;            // features alive after this frame
+  int lost_border = 0;            // left the image (or its margin)
+  int detected = 0;               // new features started in this frame
+  int refined = 0;                // positions corrected by the affine alignment
+  int reanchored = 0;             // reference patches taken again
+  int total = 0;                  // features alive after this frame
 };
 
 // A feature alive in the current frame.
@@ -130,9 +149,17 @@ class KltTracker {
 
  private:
   struct Active {
-    FeatureId id;
+    FeatureId id = 0;
     cv::Point2f px;
+    // Reference patch and the warp that maps it into the last frame.
+    FeatureTemplate reference;
+    Eigen::Matrix2f warp = Eigen::Matrix2f::Identity();
+    int reference_frame = 0;  // frame of the last alignment or reference
   };
+  // Affine alignment of `f` into `grey` (see KltTrackerOptions); sets
+  // *refined / *reanchored.
+  void RefineFeature(const cv::Mat& grey, Active* f, bool* refined,
+                     bool* reanchored) const;
   void Detect(int frame_index, const cv::Mat& grey, KltFrameStats* stats);
 
   KltTrackerOptions options_;
@@ -160,6 +187,9 @@ struct TrackingReport {
   int64_t lost_forward_backward = 0;
   int64_t lost_lk = 0;
   int64_t lost_border = 0;
+  // Affine alignments accepted, and reference patches taken again.
+  int64_t refined = 0;
+  int64_t reanchored = 0;
   double seconds = 0.0;
   double frames_per_second = 0.0;
 };

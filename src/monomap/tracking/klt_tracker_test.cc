@@ -1,13 +1,13 @@
 #include "monomap/tracking/klt_tracker.h"
 
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <opencv2/imgproc.hpp>
 #include <set>
 #include <vector>
-
-#include <gtest/gtest.h>
-#include <opencv2/imgproc.hpp>
 
 #include "monomap/util/error.h"
 
@@ -62,9 +62,9 @@ struct Sequence {
 };
 
 struct Motion {
-  double tx = 0, ty = 0;     // px per frame
-  double angle_deg = 0;      // per frame, about the image centre
-  double scale = 0;          // relative change per frame
+  double tx = 0, ty = 0;  // px per frame
+  double angle_deg = 0;   // per frame, about the image centre
+  double scale = 0;       // relative change per frame
 };
 
 Sequence MakeSequence(const cv::Mat& base, int num_frames,
@@ -113,8 +113,7 @@ std::vector<double> TrackErrors(const std::vector<Track>& tracks,
 
 TEST(KltTrackerTest, SubPixelAccuracyUnderAffineMotion) {
   const cv::Mat base = MakeTexture(1100, 900, 1);
-  const Sequence seq =
-      MakeSequence(base, 12, {0.73, -0.41, 0.25, 0.002});
+  const Sequence seq = MakeSequence(base, 12, {0.73, -0.41, 0.25, 0.002});
   KltTrackerOptions options;
   KltTracker tracker(options);
   for (int k = 0; k < 12; ++k) {
@@ -135,6 +134,45 @@ TEST(KltTrackerTest, SubPixelAccuracyUnderAffineMotion) {
               errors.size(), median, p95);
 }
 
+// Frame-to-frame LK drifts when the view zooms and rotates (each step
+// biased by the window's deformation); aligning each feature with its
+// reference patch must remove most of that drift over a long sequence.
+TEST(KltTrackerTest, AffineRefinementRemovesDriftUnderZoom) {
+  const cv::Mat base = MakeTexture(1000, 800, 7);
+  constexpr int kFrames = 60;
+  const Sequence seq = MakeSequence(base, kFrames, {0.3, 0.2, 0.3, 0.01});
+  auto last_frame_errors = [&](bool affine) {
+    KltTrackerOptions options;
+    options.affine_refinement = affine;
+    KltTracker tracker(options);
+    for (int k = 0; k < kFrames; ++k) tracker.Track(k, seq.frames[k]);
+    std::vector<double> errors;
+    for (const Track& t : tracker.FinishedTracks(40)) {
+      const Observation& first = t.observations.front();
+      const Observation& last = t.observations.back();
+      errors.push_back(
+          (seq.Predict(first.frame, first.px, last.frame) - last.px).norm());
+    }
+    return errors;
+  };
+  const std::vector<double> plain = last_frame_errors(false);
+  const std::vector<double> refined = last_frame_errors(true);
+  ASSERT_GT(plain.size(), 100u);
+  ASSERT_GT(refined.size(), 100u);
+  const double plain_median = Percentile(plain, 0.5);
+  const double refined_median = Percentile(refined, 0.5);
+  std::printf(
+      "tracks of >= 40 frames, error at their last frame: "
+      "frame-to-frame %zu tracks, median %.3f px, p90 %.3f px; "
+      "affine %zu tracks, median %.3f px, p90 %.3f px\n",
+      plain.size(), plain_median, Percentile(plain, 0.9), refined.size(),
+      refined_median, Percentile(refined, 0.9));
+  // Measured: 1.71 px without, 0.025 px with (p90 3.06 vs 0.076 px).
+  EXPECT_LT(refined_median, 0.1 * plain_median);
+  EXPECT_LT(refined_median, 0.1);
+  EXPECT_LT(Percentile(refined, 0.9), 0.3);
+}
+
 TEST(KltTrackerTest, IdsAreUniqueAndPersist) {
   const cv::Mat base = MakeTexture(1000, 800, 2);
   const Sequence seq = MakeSequence(base, 10, {0.6, 0.35, 0.0, 0.0});
@@ -143,7 +181,8 @@ TEST(KltTrackerTest, IdsAreUniqueAndPersist) {
   tracker.Track(0, seq.frames[0]);
   const std::vector<KltFeature> initial = tracker.Features();
   FeatureId max_id_so_far = -1;
-  for (const KltFeature& f : initial) max_id_so_far = std::max(max_id_so_far, f.id);
+  for (const KltFeature& f : initial)
+    max_id_so_far = std::max(max_id_so_far, f.id);
   std::set<FeatureId> seen;
   for (const KltFeature& f : initial) seen.insert(f.id);
   for (int k = 1; k < 10; ++k) {
@@ -290,10 +329,11 @@ TEST(KltTrackerTest, OccludedFeaturesAreDroppedByForwardBackwardCheck) {
   // on the new texture).
   EXPECT_GE(stats.lost_forward_backward, 0.5 * occluded);
   EXPECT_GE(clear_kept, 0.97 * clear);
-  std::printf("occlusion: %d occluded features, %d kept; lost fb %d, lk %d, "
-              "error %d\n",
-              occluded, occluded_kept, stats.lost_forward_backward,
-              stats.lost_lk, stats.lost_error);
+  std::printf(
+      "occlusion: %d occluded features, %d kept; lost fb %d, lk %d, "
+      "error %d\n",
+      occluded, occluded_kept, stats.lost_forward_backward, stats.lost_lk,
+      stats.lost_error);
 }
 
 TEST(KltTrackerTest, TrackFeaturesMatchesSerialTrackingAndReports) {

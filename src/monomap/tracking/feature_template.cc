@@ -1,0 +1,211 @@
+#include "monomap/tracking/feature_template.h"
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <Eigen/SVD>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "monomap/util/error.h"
+
+namespace monomap {
+
+void AffineRefinementOptions::Check() const {
+  CheckOption(window >= 5 && window % 2 == 1, "affine.window",
+              "must be odd and >= 5");
+  CheckOption(max_iterations >= 1, "affine.max_iterations", "must be >= 1");
+  CheckOption(epsilon_px > 0, "affine.epsilon_px", "must be > 0");
+  CheckOption(min_ncc >= -1 && min_ncc <= 1, "affine.min_ncc",
+              "must be in [-1, 1]");
+  CheckOption(max_correction_px > 0, "affine.max_correction_px", "must be > 0");
+  CheckOption(min_eigenvalue >= 0, "affine.min_eigenvalue", "must be >= 0");
+}
+
+namespace {
+
+// Bilinear sample of an 8-bit image; (x, y) must satisfy 0 <= x < cols - 1
+// and 0 <= y < rows - 1.
+inline float Sample(const cv::Mat& img, float x, float y) {
+  const int x0 = static_cast<int>(x), y0 = static_cast<int>(y);
+  const float fx = x - x0, fy = y - y0;
+  const uchar* r0 = img.ptr<uchar>(y0) + x0;
+  const uchar* r1 = r0 + img.step[0];
+  return (1.0f - fy) * ((1.0f - fx) * r0[0] + fx * r0[1]) +
+         fy * ((1.0f - fx) * r1[0] + fx * r1[1]);
+}
+
+// Whether the parallelogram A [-h, h]^2 + t lies where Sample() may read.
+bool WarpInside(const cv::Mat& img, const Eigen::Matrix2f& a,
+                const Eigen::Vector2f& t, float h) {
+  for (const float sx : {-h, h}) {
+    for (const float sy : {-h, h}) {
+      const Eigen::Vector2f p = a * Eigen::Vector2f(sx, sy) + t;
+      if (!(p.x() >= 0.0f && p.y() >= 0.0f && p.x() < img.cols - 1.001f &&
+            p.y() < img.rows - 1.001f)) {
+        return false;
+      }
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+bool FeatureTemplate::Extract(const cv::Mat& grey,
+                              const Eigen::Vector2f& center,
+                              const AffineRefinementOptions& options) {
+  values_.clear();
+  jacobian_.clear();
+  const int w = options.window;
+  const int r = w / 2;
+  // One extra pixel around the window for the central differences.
+  const float h = static_cast<float>(r + 1);
+  if (!WarpInside(grey, Eigen::Matrix2f::Identity(), center, h)) return false;
+  const int side = w + 2;
+  std::vector<float> patch(static_cast<size_t>(side) * side);
+  for (int y = 0; y < side; ++y) {
+    for (int x = 0; x < side; ++x) {
+      patch[y * side + x] =
+          Sample(grey, center.x() + (x - r - 1), center.y() + (y - r - 1));
+    }
+  }
+  double sum = 0.0, sum2 = 0.0;
+  for (int y = 1; y <= w; ++y) {
+    for (int x = 1; x <= w; ++x) {
+      const double v = patch[y * side + x];
+      sum += v;
+      sum2 += v * v;
+    }
+  }
+  const double n = static_cast<double>(w) * w;
+  const double mean = sum / n;
+  const double var = sum2 / n - mean * mean;
+  if (!(var > 1.0)) return false;  // flat: less than 1 grey level of spread
+  const float inv_sigma = static_cast<float>(1.0 / std::sqrt(var));
+
+  window_ = w;
+  values_.resize(static_cast<size_t>(n));
+  jacobian_.resize(static_cast<size_t>(6 * n));
+  Eigen::Matrix<double, 6, 6> hessian = Eigen::Matrix<double, 6, 6>::Zero();
+  Eigen::Matrix2d gradient = Eigen::Matrix2d::Zero();
+  size_t k = 0;
+  for (int y = 1; y <= w; ++y) {
+    for (int x = 1; x <= w; ++x, ++k) {
+      const float* p = &patch[y * side + x];
+      values_[k] = (p[0] - static_cast<float>(mean)) * inv_sigma;
+      const float gx = 0.5f * (p[1] - p[-1]) * inv_sigma;
+      const float gy = 0.5f * (p[side] - p[-side]) * inv_sigma;
+      const float ox = static_cast<float>(x - r - 1);
+      const float oy = static_cast<float>(y - r - 1);
+      float* j = &jacobian_[6 * k];
+      j[0] = gx * ox;
+      j[1] = gx * oy;
+      j[2] = gy * ox;
+      j[3] = gy * oy;
+      j[4] = gx;
+      j[5] = gy;
+      const Eigen::Map<const Eigen::Matrix<float, 6, 1>> jv(j);
+      hessian += (jv * jv.transpose()).cast<double>();
+      gradient += Eigen::Vector2d(gx, gy) * Eigen::Vector2d(gx, gy).transpose();
+    }
+  }
+  // The translation block must be well conditioned (a corner, not an edge).
+  const double min_eig =
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(gradient).eigenvalues()(0);
+  const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> ldlt(hessian);
+  if (min_eig / n < options.min_eigenvalue || ldlt.info() != Eigen::Success ||
+      !ldlt.isPositive() || ldlt.vectorD().minCoeff() <= 0.0) {
+    values_.clear();
+    jacobian_.clear();
+    return false;
+  }
+  hessian_inverse_ = ldlt.solve(Eigen::Matrix<double, 6, 6>::Identity());
+  return true;
+}
+
+AffineRefinement FeatureTemplate::Refine(
+    const cv::Mat& grey, Eigen::Matrix2f* a_io, Eigen::Vector2f* t_io,
+    const AffineRefinementOptions& options) const {
+  AffineRefinement result;
+  if (values_.empty()) return result;
+  const int w = window_;
+  const int r = w / 2;
+  const size_t n = values_.size();
+  Eigen::Matrix2f a = *a_io;
+  Eigen::Vector2f t = *t_io;
+  std::vector<float> samples(n);
+  double last_ncc = -1.0;
+  float last_step = std::numeric_limits<float>::infinity();
+  for (int it = 0; it < options.max_iterations; ++it) {
+    if (!WarpInside(grey, a, t, static_cast<float>(r))) return result;
+    // Resample the image under the current warp, row by row: the offsets
+    // of a row advance by A's first column.
+    double sum = 0.0, sum2 = 0.0;
+    size_t k = 0;
+    for (int y = -r; y <= r; ++y) {
+      Eigen::Vector2f p = a * Eigen::Vector2f(-r, y) + t;
+      const Eigen::Vector2f step = a.col(0);
+      for (int x = -r; x <= r; ++x, ++k, p += step) {
+        const float v = Sample(grey, p.x(), p.y());
+        samples[k] = v;
+        sum += v;
+        sum2 += static_cast<double>(v) * v;
+      }
+    }
+    const double mean = sum / n;
+    const double var = sum2 / n - mean * mean;
+    if (!(var > 1e-6)) return result;
+    const float inv_sigma = static_cast<float>(1.0 / std::sqrt(var));
+    const float fmean = static_cast<float>(mean);
+    Eigen::Matrix<double, 6, 1> b = Eigen::Matrix<double, 6, 1>::Zero();
+    float b_f[6] = {0, 0, 0, 0, 0, 0};
+    double sq = 0.0;
+    for (size_t i = 0; i < n; ++i) {
+      const float e = (samples[i] - fmean) * inv_sigma - values_[i];
+      sq += static_cast<double>(e) * e;
+      const float* j = &jacobian_[6 * i];
+      for (int q = 0; q < 6; ++q) b_f[q] += j[q] * e;
+    }
+    for (int q = 0; q < 6; ++q) b(q) = b_f[q];
+    // Both patches have unit variance: mean squared difference = 2 - 2 NCC.
+    last_ncc = 1.0 - 0.5 * sq / n;
+    result.iterations = it + 1;
+    const Eigen::Matrix<double, 6, 1> dp = hessian_inverse_ * b;
+    // Inverse compositional update: W <- W o W(dp)^-1.
+    Eigen::Matrix2d d;
+    d << 1.0 + dp(0), dp(1), dp(2), 1.0 + dp(3);
+    if (std::abs(d.determinant()) < 1e-6) return result;
+    const Eigen::Matrix2d d_inv = d.inverse();
+    const Eigen::Matrix2f a_new = (a.cast<double>() * d_inv).cast<float>();
+    const Eigen::Vector2f t_new =
+        t - (a.cast<double>() * d_inv * dp.tail<2>()).cast<float>();
+    // Converged when the feature point (the patch centre) settles; the
+    // patch corners may still wobble by a few hundredths of a pixel.
+    const float moved = (t_new - t).norm();
+    a = a_new;
+    t = t_new;
+    if (!a.allFinite() || !t.allFinite()) return result;
+    last_step = moved;
+    if (moved < options.epsilon_px) break;
+  }
+  // Noise keeps some alignments hovering: a last step within a few
+  // epsilons of the feature point is as good as settled.
+  const bool converged = last_step < 5.0f * options.epsilon_px;
+  result.ncc = last_ncc;
+  // A warp that did not settle, folded or shrank/grew wildly, or ran far
+  // from the frame-to-frame position has locked onto something else.
+  const Eigen::JacobiSVD<Eigen::Matrix2f> svd(a);
+  const float s_max = svd.singularValues()(0), s_min = svd.singularValues()(1);
+  if (!converged || a.determinant() <= 0.0f || s_min < 0.5f || s_max > 2.0f ||
+      last_ncc < options.min_ncc ||
+      (t - *t_io).norm() > options.max_correction_px) {
+    return result;
+  }
+  result.accepted = true;
+  *a_io = a;
+  *t_io = t;
+  return result;
+}
+
+}  // namespace monomap
