@@ -1,17 +1,17 @@
 #include "monomap/triangulation/bundle_adjustment.h"
 
+#include <ceres/ceres.h>
+#include <ceres/manifold.h>
+#include <ceres/product_manifold.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
 #include <iostream>
 #include <map>
 #include <memory>
 #include <unordered_map>
-
-#include <ceres/ceres.h>
-#include <ceres/manifold.h>
-#include <ceres/product_manifold.h>
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 
 #include "monomap/geometry/triangulation.h"
 #include "monomap/triangulation/projection.h"
@@ -33,9 +33,8 @@ constexpr double kRadToDeg = 180.0 / M_PI;
 struct PoseParams {
   double v[7];
 };
-using PoseManifold =
-    ceres::ProductManifold<ceres::EigenQuaternionManifold,
-                           ceres::EuclideanManifold<3>>;
+using PoseManifold = ceres::ProductManifold<ceres::EigenQuaternionManifold,
+                                            ceres::EuclideanManifold<3>>;
 
 PoseParams ToParams(const Rigid3d& cam_from_world) {
   PoseParams p;
@@ -62,8 +61,7 @@ struct ReprojectionCost {
     const Eigen::Map<const Eigen::Quaternion<T>> rotation(pose);
     const Eigen::Map<const Eigen::Matrix<T, 3, 1>> translation(pose + 4);
     const Eigen::Map<const Eigen::Matrix<T, 3, 1>> x_in_world(x);
-    const Eigen::Matrix<T, 3, 1> x_in_cam =
-        rotation * x_in_world + translation;
+    const Eigen::Matrix<T, 3, 1> x_in_cam = rotation * x_in_world + translation;
     // A point crossing the image plane has no projection: reject the step.
     if (!(x_in_cam.z() > T(1e-6))) return false;
     T px[2];
@@ -229,8 +227,7 @@ void BundleAdjustmentOptions::Check() const {
               "must be >= 0");
   CheckOption(max_points >= 0, "max_points", "must be >= 0");
   CheckOption(max_num_iterations >= 0, "max_num_iterations", "must be >= 0");
-  CheckOption(function_tolerance > 0, "function_tolerance",
-              "must be positive");
+  CheckOption(function_tolerance > 0, "function_tolerance", "must be positive");
   CheckOption(num_threads >= 1, "num_threads", "must be >= 1");
   CheckOption(max_reprojection_error_px > 0, "max_reprojection_error_px",
               "must be positive");
@@ -282,9 +279,9 @@ BundleAdjustmentReport BundleAdjust(const Camera& camera,
   for (size_t i = 0; i < landmarks->size(); ++i) {
     points[i] = (*landmarks)[i].x_in_world;
   }
-  RmsAndMedian(ReprojectionErrors(camera, cams_from_world, landmark_tracks,
-                                  points),
-               &report.initial_rms_error_px, &report.initial_median_error_px);
+  RmsAndMedian(
+      ReprojectionErrors(camera, cams_from_world, landmark_tracks, points),
+      &report.initial_rms_error_px, &report.initial_median_error_px);
   report.num_points = static_cast<int>(landmarks->size());
 
   if (!options.enabled || landmarks->empty() || num_frames == 0) {
@@ -368,10 +365,9 @@ BundleAdjustmentReport BundleAdjust(const Camera& camera,
     } else {
       problem.AddResidualBlock(
           new ceres::AutoDiffCostFunction<AbsolutePoseCost, 6, 7>(
-              new AbsolutePoseCost(cams_from_world[first],
-                                   options.translation_sigma_floor_m,
-                                   options.rotation_sigma_floor_deg *
-                                       kDegToRad)),
+              new AbsolutePoseCost(
+                  cams_from_world[first], options.translation_sigma_floor_m,
+                  options.rotation_sigma_floor_deg * kDegToRad)),
           nullptr, poses[first].v);
     }
   }
@@ -390,9 +386,14 @@ BundleAdjustmentReport BundleAdjust(const Camera& camera,
   }
 
   ceres::Solver::Options solver_options;
-  solver_options.linear_solver_type = options.iterative_schur
-                                          ? ceres::ITERATIVE_SCHUR
-                                          : ceres::SPARSE_SCHUR;
+  int num_pose_blocks = 0;
+  for (int i = first; i <= last; ++i) {
+    num_pose_blocks += problem.HasParameterBlock(poses[i].v) ? 1 : 0;
+  }
+  solver_options.linear_solver_type =
+      options.iterative_schur ? ceres::ITERATIVE_SCHUR
+      : num_pose_blocks <= options.dense_schur_max_poses ? ceres::DENSE_SCHUR
+                                                         : ceres::SPARSE_SCHUR;
   if (options.iterative_schur) {
     solver_options.preconditioner_type = ceres::SCHUR_JACOBI;
   }
@@ -433,8 +434,8 @@ BundleAdjustmentReport BundleAdjust(const Camera& camera,
   }
   for (int i = 0; i < num_frames; ++i) {
     cams_from_world[i] = (*world_from_cam)[i].Inverse();
-    sum_change_m += ((*world_from_cam)[i].translation - odometry[i].translation)
-                        .norm();
+    sum_change_m +=
+        ((*world_from_cam)[i].translation - odometry[i].translation).norm();
     sum_change_rad +=
         AngleBetween((*world_from_cam)[i].rotation, odometry[i].rotation);
   }
@@ -444,27 +445,27 @@ BundleAdjustmentReport BundleAdjust(const Camera& camera,
   // Landmarks left out of the joint problem: refined alone with the
   // adjusted poses held fixed.
   const TriangulationOptions refine_options;
-  tbb::parallel_for(
-      tbb::blocked_range<size_t>(0, points.size(), 64),
-      [&](const tbb::blocked_range<size_t>& range) {
-        for (size_t i = range.begin(); i != range.end(); ++i) {
-          if (joint[i] || !points[i].allFinite()) continue;
-          RefinePoint(camera, cams_from_world, *landmark_tracks[i],
-                      refine_options, &points[i]);
-        }
-      });
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, points.size(), 64),
+                    [&](const tbb::blocked_range<size_t>& range) {
+                      for (size_t i = range.begin(); i != range.end(); ++i) {
+                        if (joint[i] || !points[i].allFinite()) continue;
+                        RefinePoint(camera, cams_from_world,
+                                    *landmark_tracks[i], refine_options,
+                                    &points[i]);
+                      }
+                    });
 
-  RmsAndMedian(ReprojectionErrors(camera, cams_from_world, landmark_tracks,
-                                  points),
-               &report.final_rms_error_px, &report.final_median_error_px);
+  RmsAndMedian(
+      ReprojectionErrors(camera, cams_from_world, landmark_tracks, points),
+      &report.final_rms_error_px, &report.final_median_error_px);
 
   // Update landmarks; drop the ones bundle adjustment could not reconcile.
   std::vector<Landmark> kept;
   kept.reserve(landmarks->size());
   for (size_t i = 0; i < landmarks->size(); ++i) {
     Landmark l = (*landmarks)[i];
-    const PointStatistics s = EvaluatePoint(camera, cams_from_world,
-                                            *landmark_tracks[i], points[i]);
+    const PointStatistics s =
+        EvaluatePoint(camera, cams_from_world, *landmark_tracks[i], points[i]);
     if (!points[i].allFinite() ||
         s.mean_error_px > options.max_reprojection_error_px ||
         s.min_depth_m < options.min_depth_m) {

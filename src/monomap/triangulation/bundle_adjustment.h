@@ -57,7 +57,11 @@ struct BundleAdjustmentOptions {
   // costs iterations that move poses by micrometres.
   double function_tolerance = 1e-4;
   // Threads Ceres uses for Jacobians and the linear solver.
-  int num_threads = 2;
+  int num_threads = 1;
+  // Up to this many poses the reduced camera system is solved densely
+  // (DENSE_SCHUR): tracks span tens of frames, so it is nearly full anyway
+  // and the dense path is faster than the block-sparse one.
+  int dense_schur_max_poses = 400;
   // Use ITERATIVE_SCHUR (preconditioned CG) instead of SPARSE_SCHUR: for
   // very long sequences where the reduced camera system gets large.
   bool iterative_schur = false;
@@ -75,19 +79,19 @@ struct BundleAdjustmentOptions {
 };
 
 struct BundleAdjustmentReport {
-  int num_poses = 0;          // pose blocks in the problem
-  int num_points = 0;         // landmarks given
-  int num_points_joint = 0;   // of which in the joint adjustment
-  int num_residuals = 0;      // reprojection residual blocks (observations)
-  int num_priors = 0;         // odometry prior residual blocks
-  double initial_rms_error_px = 0.0;     // reprojection, all observations
+  int num_poses = 0;         // pose blocks in the problem
+  int num_points = 0;        // landmarks given
+  int num_points_joint = 0;  // of which in the joint adjustment
+  int num_residuals = 0;     // reprojection residual blocks (observations)
+  int num_priors = 0;        // odometry prior residual blocks
+  double initial_rms_error_px = 0.0;  // reprojection, all observations
   double final_rms_error_px = 0.0;
   double initial_median_error_px = 0.0;
   double final_median_error_px = 0.0;
   int iterations = 0;
-  std::string termination;    // Ceres termination type, "disabled" if off
-  int num_dropped = 0;        // landmarks dropped after adjustment
-  double mean_pose_change_m = 0.0;    // mean camera centre displacement
+  std::string termination;          // Ceres termination type, "disabled" if off
+  int num_dropped = 0;              // landmarks dropped after adjustment
+  double mean_pose_change_m = 0.0;  // mean camera centre displacement
   double mean_pose_change_deg = 0.0;  // mean rotation change
   double seconds = 0.0;
 };
