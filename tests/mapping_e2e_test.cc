@@ -3,7 +3,6 @@
 // accuracy figures, not just that it ran. Each fixture prints its figures
 // (run the test binary to see them).
 #include <gtest/gtest.h>
-
 #include <unistd.h>
 
 #include <cmath>
@@ -52,8 +51,7 @@ std::unique_ptr<MappedWorld> SimulateAndMap(const SimulationOptions& sim,
   w->result = BuildMap(dataset, MappingOptions{});
   w->mapping_seconds = mapping_timer.ElapsedSeconds();
   w->truth = ReadMap(w->dir / "structure");
-  w->accuracy = EvaluateStructure(w->result.map, w->truth,
-                                  Rigid3d::Identity(),
+  w->accuracy = EvaluateStructure(w->result.map, w->truth, Rigid3d::Identity(),
                                   StructureAccuracyOptions{});
   std::printf("%s: simulate %.1f s, map %.1f s\n%s", name.c_str(),
               w->simulate_seconds, w->mapping_seconds,
@@ -144,7 +142,9 @@ TEST_F(MappingE2E, FloorIsFoundWithinOneDegree) {
 }
 
 // Hallway at 640x480, 150 frames (seed 1, as the demo): every wall the
-// camera sees well enough is a plane.
+// camera sees well enough is a plane. Odometry errors as the lab corner:
+// with the simulator's default 1% scale error the walls sit ~1.6% off
+// their true offset, because the map inherits the odometry's scale.
 class MappingE2EHallway : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
@@ -154,6 +154,8 @@ class MappingE2EHallway : public ::testing::Test {
     sim.num_frames = 150;
     sim.width = 640;
     sim.height = 480;
+    sim.odometry.wheel_radius_error = 0.003;
+    sim.odometry.yaw_scale_error = 0.003;
     world_ = SimulateAndMap(sim, "hallway").release();
   }
   static void TearDownTestSuite() {

@@ -10,6 +10,32 @@
 #include "monomap/util/file.h"
 
 namespace monomap {
+namespace {
+
+// The texture in grey, its unseen texels (alpha 0) shown on white as a
+// viewer shows a transparent PNG. The detector needs a light quiet zone
+// around the board, and a plane's extent (the outline of its features) may
+// stop at the last squares, since a board's blank margin has no corners.
+cv::Mat GreyOnWhite(const cv::Mat& texture) {
+  cv::Mat grey;
+  if (texture.channels() == 1) return texture.clone();
+  if (texture.channels() == 3) {
+    cv::cvtColor(texture, grey, cv::COLOR_BGR2GRAY);
+    return grey;
+  }
+  cv::cvtColor(texture, grey, cv::COLOR_BGRA2GRAY);
+  for (int r = 0; r < texture.rows; ++r) {
+    const cv::Vec4b* t = texture.ptr<cv::Vec4b>(r);
+    uchar* g = grey.ptr<uchar>(r);
+    for (int c = 0; c < texture.cols; ++c) {
+      const int a = t[c][3];
+      g[c] = static_cast<uchar>((g[c] * a + 255 * (255 - a) + 127) / 255);
+    }
+  }
+  return grey;
+}
+
+}  // namespace
 
 CheckerboardAccuracy EvaluateCheckerboard(const Map& map,
                                           const CheckerboardSpec& spec) {
@@ -17,10 +43,7 @@ CheckerboardAccuracy EvaluateCheckerboard(const Map& map,
   const cv::Size pattern(spec.inner_corners_x, spec.inner_corners_y);
   for (const TexturedPlane& plane : map.planes) {
     if (plane.texture.empty()) continue;
-    cv::Mat grey;
-    cv::cvtColor(plane.texture, grey, plane.texture.channels() == 4
-                                          ? cv::COLOR_BGRA2GRAY
-                                          : cv::COLOR_BGR2GRAY);
+    const cv::Mat grey = GreyOnWhite(plane.texture);
     std::vector<cv::Point2f> corners;
     if (!cv::findChessboardCorners(
             grey, pattern, corners,
