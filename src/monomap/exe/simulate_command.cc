@@ -1,4 +1,5 @@
-// monomap simulate WORLD -o DATASET_DIR [--seed N] [--frames N] ...
+// monomap simulate WORLD -o DATASET_DIR [--seed N] [--run-seed N]
+//   [--frames N] [--start-offset M] [--lateral-offset M] ...
 #include <cstdio>
 #include <memory>
 
@@ -24,7 +25,16 @@ void RegisterSimulateCommand(CLI::App& app) {
   cmd->add_option("world", o->world, "World name")->required();
   cmd->add_option("-o,--output", *out, "Dataset directory to write")
       ->required();
-  cmd->add_option("--seed", o->seed, "Seed of textures, noise and odometry");
+  cmd->add_option("--seed", o->seed,
+                  "Seed of the world (textures) and, without --run-seed, of "
+                  "the run");
+  cmd->add_option("--run-seed", o->run_seed,
+                  "Seed of this traversal: odometry errors, exposure and "
+                  "image noise (0: --seed)");
+  cmd->add_option("--start-offset", o->path.start_offset_m,
+                  "Start this far along the path (m)");
+  cmd->add_option("--lateral-offset", o->path.lateral_offset_m,
+                  "Drive parallel to the path, this far to the left (m)");
   cmd->add_option("--frames", o->num_frames,
                   "Number of frames (default: the whole path)");
   cmd->add_option("--width", o->width, "Image width");

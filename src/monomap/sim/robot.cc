@@ -59,9 +59,15 @@ void RobotPathOptions::Check() const {
               "must be in [1, 1000] Hz");
   CheckOption(std::isfinite(start_time) && start_time >= 0.0,
               "path.start_time", "must be >= 0");
+  CheckOption(std::isfinite(start_offset_m) && start_offset_m >= 0.0,
+              "path.start_offset_m", "must be >= 0");
+  CheckOption(std::isfinite(lateral_offset_m) &&
+                  std::abs(lateral_offset_m) < 5.0,
+              "path.lateral_offset_m", "must be within +-5 m");
 }
 
-RobotPath::RobotPath(std::vector<Vector2d> keypoints, bool closed) {
+RobotPath::RobotPath(std::vector<Vector2d> keypoints, bool closed)
+    : closed_(closed) {
   const size_t n = keypoints.size();
   if (n < (closed ? 3u : 2u)) {
     throw OptionsError("path: needs at least " +
@@ -123,13 +129,79 @@ std::vector<TimedPose2d> SampleRobotPath(const RobotPath& path,
                                          const RobotPathOptions& options,
                                          int max_samples) {
   options.Check();
+  const double length = path.Length();
+  if (!path.closed() && !(options.start_offset_m < length)) {
+    throw OptionsError("path.start_offset_m: must be shorter than the open "
+                       "path (" + std::to_string(length) + " m)");
+  }
+  // Distance driven along the path from the start offset -> path pose.
+  const double start =
+      path.closed() ? std::fmod(options.start_offset_m, length)
+                    : options.start_offset_m;
+  const double span = path.closed() ? length : length - start;
+  auto base_pose = [&](double driven) {
+    double s = start + driven;
+    if (path.closed() && s > length) s -= length;
+    return path.PoseAt(s);
+  };
   const double step = options.speed_mps / options.rate_hz;
-  int n = static_cast<int>(std::floor(path.Length() / step)) + 1;
-  if (max_samples > 0) n = std::min(n, max_samples);
+  auto sample_count = [&](double driven_length) {
+    int n = static_cast<int>(std::floor(driven_length / step)) + 1;
+    if (max_samples > 0) n = std::min(n, max_samples);
+    return n;
+  };
+
+  const double d = options.lateral_offset_m;
+  if (d == 0.0) {
+    const int n = sample_count(span);
+    std::vector<TimedPose2d> out(n);
+    for (int k = 0; k < n; ++k) {
+      out[k].timestamp = options.start_time + k / options.rate_hz;
+      out[k].pose = base_pose(k * step);
+    }
+    return out;
+  }
+
+  // The parallel curve shares the path's tangents; its arc length differs
+  // in turns (ds' = (1 - curvature * d) ds), so tabulate it to drive it at
+  // constant speed.
+  auto offset_pose = [&](double driven) {
+    Pose2d p = base_pose(driven);
+    p.x -= d * std::sin(p.yaw);
+    p.y += d * std::cos(p.yaw);
+    return p;
+  };
+  constexpr double kTableStep = 1e-3;  // m of the path
+  const int m = std::max(1, static_cast<int>(std::ceil(span / kTableStep)));
+  std::vector<double> table_driven(m + 1), table_offset(m + 1, 0.0);
+  Pose2d prev = offset_pose(0.0);
+  for (int i = 1; i <= m; ++i) {
+    table_driven[i] = span * i / m;
+    const Pose2d p = offset_pose(table_driven[i]);
+    const Vector2d delta(p.x - prev.x, p.y - prev.y);
+    // Moving forward at less than a tenth of the path's speed: the offset
+    // is (nearly) at the turn's centre.
+    if (delta.dot(Vector2d(std::cos(p.yaw), std::sin(p.yaw))) <
+        0.1 * (table_driven[i] - table_driven[i - 1])) {
+      throw OptionsError("path.lateral_offset_m: " + std::to_string(d) +
+                         " m reaches the centre of a turn of the path");
+    }
+    table_offset[i] = table_offset[i - 1] + delta.norm();
+    prev = p;
+  }
+  const int n = sample_count(table_offset[m]);
   std::vector<TimedPose2d> out(n);
   for (int k = 0; k < n; ++k) {
+    const double target = std::min(k * step, table_offset[m]);
+    const auto it =
+        std::lower_bound(table_offset.begin(), table_offset.end(), target);
+    const size_t i = std::clamp<size_t>(it - table_offset.begin(), 1,
+                                        table_offset.size() - 1);
+    const double ds = table_offset[i] - table_offset[i - 1];
+    const double f = ds > 0 ? (target - table_offset[i - 1]) / ds : 0.0;
     out[k].timestamp = options.start_time + k / options.rate_hz;
-    out[k].pose = path.PoseAt(k * step);
+    out[k].pose = offset_pose(table_driven[i - 1] +
+                              f * (table_driven[i] - table_driven[i - 1]));
   }
   return out;
 }

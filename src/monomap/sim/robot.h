@@ -45,6 +45,15 @@ struct RobotPathOptions {
   double rate_hz = 30.0;
   // Timestamp of the first sample (s); TUM-like data starts far from 0.
   double start_time = 1000.0;
+  // Start this far along the path (m, >= 0). An open path is then driven to
+  // its end (the offset must be shorter than the path); a closed one is
+  // still driven once around, wrapping past its first keypoint.
+  double start_offset_m = 0.0;
+  // Drive parallel to the path, this far to the left of the heading (m;
+  // negative: to the right), at the same constant speed along the offset
+  // curve. Must stay below the path's smallest turning radius on the inner
+  // side (SampleRobotPath throws OptionsError otherwise).
+  double lateral_offset_m = 0.0;
 
   void Check() const;
 };
@@ -60,18 +69,24 @@ class RobotPath {
       : RobotPath(world.path_keypoints, world.path_closed) {}
 
   double Length() const { return table_s_.back(); }
+  bool closed() const { return closed_; }
   // Base pose after driving `s` metres (clamped to [0, Length()]).
   Pose2d PoseAt(double s) const;
 
  private:
   Eigen::Vector2d Point(double u, Eigen::Vector2d* tangent) const;
   std::vector<Eigen::Vector2d> ctrl_;  // with phantom/wrapped ends
+  bool closed_ = false;
   int segments_ = 0;
   std::vector<double> table_u_, table_s_;  // arc-length table
 };
 
-// Samples the path at options.rate_hz and constant speed from start to end
-// (loops are driven once). max_samples > 0 truncates.
+// Samples the path at options.rate_hz and constant speed from
+// options.start_offset_m to the end (loops are driven once), offset
+// options.lateral_offset_m to the left. max_samples > 0 truncates. Throws
+// OptionsError if the start offset is not shorter than an open path, or if
+// the lateral offset reaches a turn's centre (the offset curve would turn
+// back on itself).
 std::vector<TimedPose2d> SampleRobotPath(const RobotPath& path,
                                          const RobotPathOptions& options,
                                          int max_samples = -1);

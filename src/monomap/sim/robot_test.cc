@@ -121,12 +121,138 @@ TEST(RobotTest, DefaultDriftIsOneToFewPercent) {
   EXPECT_NE(a.back().pose.x, c.back().pose.x);
 }
 
+// Signed distance of q to the left of the path (nearest point of a dense
+// sampling of the whole path).
+double LeftDistance(const RobotPath& path, const Pose2d& q) {
+  double best = 1e300, signed_distance = 0.0;
+  const int n = static_cast<int>(path.Length() / 5e-4);
+  for (int i = 0; i <= n; ++i) {
+    const Pose2d p = path.PoseAt(path.Length() * i / n);
+    const double dx = q.x - p.x, dy = q.y - p.y;
+    const double dist = std::hypot(dx, dy);
+    if (dist < best) {
+      best = dist;
+      signed_distance = -std::sin(p.yaw) * dx + std::cos(p.yaw) * dy;
+    }
+  }
+  return signed_distance;
+}
+
+TEST(RobotTest, StartOffsetOnAStraightPath) {
+  const RobotPath path({{0, 0}, {10, 0}}, false);
+  RobotPathOptions o;
+  o.start_offset_m = 2.5;
+  const auto poses = SampleRobotPath(path, o);
+  const double step = o.speed_mps / o.rate_hz;
+  ASSERT_EQ(poses.size(), static_cast<size_t>(std::floor(7.5 / step)) + 1);
+  EXPECT_NEAR(poses[0].timestamp, o.start_time, 1e-12);
+  for (size_t k = 0; k < poses.size(); ++k) {
+    EXPECT_NEAR(poses[k].pose.x, 2.5 + k * step, 1e-6);
+    EXPECT_NEAR(poses[k].pose.y, 0.0, 1e-9);
+    EXPECT_NEAR(poses[k].pose.yaw, 0.0, 1e-9);
+  }
+  o.start_offset_m = 10.0;  // not shorter than the open path
+  EXPECT_THROW(SampleRobotPath(path, o), OptionsError);
+}
+
+TEST(RobotTest, LateralOffsetOnAStraightPathIsToTheLeft) {
+  const RobotPath path({{0, 0}, {0, 10}}, false);  // heading +y: left is -x
+  RobotPathOptions o;
+  o.lateral_offset_m = 0.3;
+  const auto poses = SampleRobotPath(path, o, 50);
+  ASSERT_EQ(poses.size(), 50u);
+  const double step = o.speed_mps / o.rate_hz;
+  for (size_t k = 0; k < poses.size(); ++k) {
+    EXPECT_NEAR(poses[k].pose.x, -0.3, 1e-9);
+    EXPECT_NEAR(poses[k].pose.y, k * step, 1e-6);
+    EXPECT_NEAR(poses[k].pose.yaw, M_PI / 2, 1e-9);
+  }
+  o.lateral_offset_m = -0.3;
+  EXPECT_NEAR(SampleRobotPath(path, o, 5)[4].pose.x, 0.3, 1e-9);
+}
+
+TEST(RobotTest, OffsetPathIsParallelAtConstantSpeed) {
+  for (const std::string& name : WorldNames()) {
+    SCOPED_TRACE(name);
+    const World w = MakeWorld(name, 1, 20.0);
+    const RobotPath path(w);
+    RobotPathOptions o;
+    o.start_offset_m = 1.2;
+    o.lateral_offset_m = 0.15;
+    const auto poses = SampleRobotPath(path, o);
+    ASSERT_GT(poses.size(), 100u);
+    // Starts beside the path point 1.2 m along it.
+    const Pose2d s = path.PoseAt(1.2);
+    EXPECT_NEAR(poses[0].pose.x, s.x - 0.15 * std::sin(s.yaw), 1e-9);
+    EXPECT_NEAR(poses[0].pose.y, s.y + 0.15 * std::cos(s.yaw), 1e-9);
+    EXPECT_NEAR(poses[0].pose.yaw, s.yaw, 1e-9);
+    const double step = o.speed_mps / o.rate_hz;
+    for (size_t k = 0; k < poses.size(); k += 7) {
+      EXPECT_NEAR(LeftDistance(path, poses[k].pose), 0.15, 2e-3) << k;
+    }
+    for (size_t k = 1; k < poses.size(); ++k) {
+      const double dx = poses[k].pose.x - poses[k - 1].pose.x;
+      const double dy = poses[k].pose.y - poses[k - 1].pose.y;
+      EXPECT_NEAR(std::hypot(dx, dy), step, 0.02 * step) << k;
+      // Still heading along the direction of motion.
+      EXPECT_LT(std::abs(std::remainder(
+                    std::atan2(dy, dx) - poses[k].pose.yaw, 2 * M_PI)),
+                0.05);
+    }
+    if (path.closed()) {
+      // A loop is still driven once around: it ends near its start.
+      EXPECT_LT(std::hypot(poses.back().pose.x - poses[0].pose.x,
+                           poses.back().pose.y - poses[0].pose.y),
+                2 * step);
+    } else {
+      // An open path ends beside its end.
+      const Pose2d e = path.PoseAt(path.Length());
+      EXPECT_LT(
+          std::hypot(poses.back().pose.x - (e.x - 0.15 * std::sin(e.yaw)),
+                     poses.back().pose.y - (e.y + 0.15 * std::cos(e.yaw))),
+          1.5 * step);
+    }
+  }
+}
+
+TEST(RobotTest, LateralOffsetBeyondATurnCentreThrows) {
+  // A circle of radius ~1 m driven counter-clockwise: its centre is on the
+  // left.
+  std::vector<Eigen::Vector2d> circle;
+  for (int i = 0; i < 12; ++i) {
+    circle.emplace_back(std::cos(i * M_PI / 6), std::sin(i * M_PI / 6));
+  }
+  const RobotPath path(circle, true);
+  RobotPathOptions o;
+  o.lateral_offset_m = 0.5;  // inside: radius 0.5
+  const auto inside = SampleRobotPath(path, o);
+  EXPECT_NEAR(PathLength(inside), M_PI, 0.05);
+  o.lateral_offset_m = -0.5;  // outside: radius 1.5
+  EXPECT_NEAR(PathLength(SampleRobotPath(path, o)), 3 * M_PI, 0.05);
+  o.lateral_offset_m = 1.2;  // beyond the centre
+  EXPECT_THROW(SampleRobotPath(path, o), OptionsError);
+  // A loop wraps around its first keypoint.
+  o.lateral_offset_m = 0.0;
+  o.start_offset_m = path.Length() + 0.5;
+  const auto wrapped = SampleRobotPath(path, o);
+  const Pose2d s = path.PoseAt(0.5);
+  EXPECT_NEAR(wrapped[0].pose.x, s.x, 1e-9);
+  EXPECT_NEAR(wrapped[0].pose.y, s.y, 1e-9);
+  EXPECT_NEAR(PathLength(wrapped), path.Length(), 0.02);
+}
+
 TEST(RobotTest, OptionsAreChecked) {
   OdometryNoiseOptions o;
   o.translation_noise = -1;
   EXPECT_THROW(o.Check(), OptionsError);
   RobotPathOptions p;
   p.speed_mps = 0;
+  EXPECT_THROW(p.Check(), OptionsError);
+  p = RobotPathOptions();
+  p.start_offset_m = -0.1;
+  EXPECT_THROW(p.Check(), OptionsError);
+  p = RobotPathOptions();
+  p.lateral_offset_m = std::nan("");
   EXPECT_THROW(p.Check(), OptionsError);
   EXPECT_THROW(RobotPath({{0, 0}}, false), OptionsError);
 }

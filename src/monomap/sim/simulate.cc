@@ -105,8 +105,10 @@ SimulationReport Simulate(const SimulationOptions& options,
   const RobotPath path(world);
   const std::vector<TimedPose2d> truth =
       SampleRobotPath(path, options.path, options.num_frames);
+  const uint64_t run_seed =
+      options.run_seed != 0 ? options.run_seed : options.seed;
   const std::vector<TimedPose2d> odom =
-      SimulateOdometry(truth, options.odometry, options.seed);
+      SimulateOdometry(truth, options.odometry, run_seed);
   const Rigid3d base_from_cam = MakeCameraMount(options.mount);
   const std::vector<TimedPose> gt_cam = CameraPoses(truth, base_from_cam);
   const std::vector<TimedPose> odom_cam = CameraPoses(odom, base_from_cam);
@@ -201,7 +203,7 @@ SimulationReport Simulate(const SimulationOptions& options,
     const cv::Mat radiance = renderer.Render(world_from_cam, highlights);
     const cv::Mat image = ApplyCameraEffects(
         radiance, truth[i].timestamp - truth[0].timestamp, options.effects,
-        options.seed, SimMixSeed(options.seed, 1000000 + i));
+        run_seed, SimMixSeed(run_seed, 1000000 + i));
     char name[32];
     std::snprintf(name, sizeof(name), "rgb/%06d.png", i);
     if (!cv::imwrite((root / name).string(), image)) {

@@ -17,8 +17,13 @@ namespace monomap {
 struct SimulationOptions {
   // World to drive through: one of WorldNames().
   std::string world = "hallway";
-  // Seed of textures, odometry errors and image noise.
+  // Seed of the world (its textures) and, unless run_seed is set, of the
+  // run too.
   uint64_t seed = 1;
+  // Seed of one traversal of the world: odometry errors, exposure variation
+  // and image noise. 0: use `seed`. Two runs of the same world differ only
+  // in their run_seed (and path options).
+  uint64_t run_seed = 0;
   // Number of frames; -1 (or more than the path holds) drives the whole
   // path once.
   int num_frames = -1;
@@ -32,7 +37,8 @@ struct SimulationOptions {
   double k2 = 0.07;
   // Texture resolution of the world (texels per metre).
   double texture_pixels_per_meter = kDefaultWorldPixelsPerMeter;
-  // Robot motion, camera mount and odometry errors.
+  // Robot motion (including start and lateral offsets), camera mount and
+  // odometry errors.
   RobotPathOptions path;
   CameraMountOptions mount;
   OdometryNoiseOptions odometry;

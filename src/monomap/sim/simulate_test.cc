@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <map>
 #include <opencv2/imgcodecs.hpp>
@@ -140,6 +141,60 @@ TEST(SimulateTest, DeterministicForASeed) {
   EXPECT_NE(fa.at("rgb/000000.png"), fc.at("rgb/000000.png"));
   EXPECT_NE(fa.at("odometry2d.txt"), fc.at("odometry2d.txt"));
   for (const auto& p : {a, b, c}) fs::remove_all(p);
+}
+
+TEST(SimulateTest, RunSeedChangesTheRunButNotTheWorld) {
+  const fs::path a = TempDir("run_a"), b = TempDir("run_b"),
+                 c = TempDir("run_c");
+  SimulationOptions o = SmallOptions();
+  o.num_frames = 4;
+  o.seed = 3;
+  Simulate(o, a);
+  o.run_seed = 3;  // the same as run_seed 0
+  Simulate(o, b);
+  o.run_seed = 11;
+  Simulate(o, c);
+  const auto fa = ReadTree(a), fb = ReadTree(b), fc = ReadTree(c);
+  ASSERT_EQ(fa.size(), fb.size());
+  for (const auto& [name, bytes] : fa) {
+    EXPECT_TRUE(bytes == fb.at(name)) << name << " differs";
+  }
+  // Another run: other odometry errors and image noise, same path.
+  EXPECT_NE(fa.at("odometry2d.txt"), fc.at("odometry2d.txt"));
+  EXPECT_NE(fa.at("rgb/000002.png"), fc.at("rgb/000002.png"));
+  EXPECT_EQ(fa.at("groundtruth.txt"), fc.at("groundtruth.txt"));
+  // Same world: without camera effects the images are identical.
+  const fs::path d = TempDir("run_d"), e = TempDir("run_e");
+  o.effects = CameraEffectsOptions::None();
+  o.run_seed = 0;
+  Simulate(o, d);
+  o.run_seed = 11;
+  Simulate(o, e);
+  const auto fd = ReadTree(d), fe = ReadTree(e);
+  EXPECT_EQ(fd.at("rgb/000002.png"), fe.at("rgb/000002.png"));
+  for (const auto& p : {a, b, c, d, e}) fs::remove_all(p);
+}
+
+TEST(SimulateTest, PathOffsetsMoveTheRun) {
+  const fs::path dir = TempDir("offsets");
+  SimulationOptions o = SmallOptions();
+  o.world = "hallway";
+  o.num_frames = 3;
+  o.path.start_offset_m = 1.0;
+  o.path.lateral_offset_m = 0.2;
+  Simulate(o, dir);
+  const Dataset ds = LoadDataset(dir);
+  const World world = MakeWorld(o.world, o.seed, o.texture_pixels_per_meter);
+  const Pose2d s = RobotPath(world).PoseAt(1.0);
+  const Pose2d start{s.x - 0.2 * std::sin(s.yaw), s.y + 0.2 * std::cos(s.yaw),
+                     s.yaw};
+  const Rigid3d expected = WorldFromCamOfBase(start, *ds.base_from_cam);
+  EXPECT_LT((ds.frames[0].groundtruth_world_from_cam->translation -
+             expected.translation).norm(), 1e-6);
+  // Odometry is anchored at the run's true start.
+  EXPECT_NEAR(ds.frames[0].odometry_base->x, start.x, 1e-6);
+  EXPECT_NEAR(ds.frames[0].odometry_base->y, start.y, 1e-6);
+  fs::remove_all(dir);
 }
 
 TEST(SimulateTest, DriftIsReportedAndZeroWithoutNoise) {
