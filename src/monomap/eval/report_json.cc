@@ -62,12 +62,25 @@ nlohmann::json ToJson(const StructureAccuracy& a) {
   return j;
 }
 
+nlohmann::json ToJson(const RenderFidelity& f) {
+  nlohmann::json frames = nlohmann::json::array();
+  for (const FrameFidelity& x : f.frames) {
+    frames.push_back({{"frame", x.frame},
+                      {"coverage", x.coverage},
+                      {"ncc", x.ncc},
+                      {"psnr_db", x.psnr_db}});
+  }
+  return {{"compared", f.frames.size()},    {"skipped", f.skipped},
+          {"ncc", ToJson(f.ncc)},           {"psnr_db", ToJson(f.psnr_db)},
+          {"coverage", ToJson(f.coverage)}, {"frames", frames}};
+}
+
 namespace {
 
 std::string Header() {
   char buf[160];
-  std::snprintf(buf, sizeof(buf), "%-20s %8s %10s %10s %10s %10s %10s\n",
-                "", "count", "mean", "median", "p90", "max", "rms");
+  std::snprintf(buf, sizeof(buf), "%-20s %8s %10s %10s %10s %10s %10s\n", "",
+                "count", "mean", "median", "p90", "max", "rms");
   return buf;
 }
 
@@ -96,6 +109,15 @@ std::string FormatTable(const TrajectoryErrors& e) {
          Row("rotation (deg)", e.rotation_deg, 1.0);
 }
 
+std::string FormatTable(const RenderFidelity& f) {
+  char buf[96];
+  std::snprintf(buf, sizeof(buf), "%zu frames compared, %d skipped\n",
+                f.frames.size(), f.skipped);
+  return buf + Header() + Row("NCC", f.ncc, 1.0) +
+         Row("PSNR (dB)", f.psnr_db, 1.0) +
+         Row("coverage (%)", f.coverage, 100.0);
+}
+
 std::string FormatTable(const StructureAccuracy& a) {
   int matched_fitted = 0, matched_observed = 0;
   for (const PlaneMatch& m : a.matches) matched_fitted += m.matched;
@@ -113,13 +135,13 @@ std::string FormatTable(const StructureAccuracy& a) {
                 matched_fitted, a.fitted_planes, 100 * a.recall,
                 matched_observed, a.observed_true_planes);
   std::string out = buf;
-  out += Header() + Row("all abs (mm)", a.point_error_all.absolute_m, 1e3) +
-         Row("all rel (%)", a.point_error_all.relative_percent, 1.0) +
-         Row("on planes abs (mm)", a.point_error_on_planes.absolute_m, 1e3) +
-         Row("on planes rel (%)", a.point_error_on_planes.relative_percent,
-             1.0) +
-         Row("normal error (deg)", a.normal_error_deg, 1.0) +
-         Row("offset error (mm)", a.offset_error_m, 1e3);
+  out +=
+      Header() + Row("all abs (mm)", a.point_error_all.absolute_m, 1e3) +
+      Row("all rel (%)", a.point_error_all.relative_percent, 1.0) +
+      Row("on planes abs (mm)", a.point_error_on_planes.absolute_m, 1e3) +
+      Row("on planes rel (%)", a.point_error_on_planes.relative_percent, 1.0) +
+      Row("normal error (deg)", a.normal_error_deg, 1.0) +
+      Row("offset error (mm)", a.offset_error_m, 1e3);
   out += "fitted  inliers  true  normal(deg)  offset(mm)  match\n";
   for (const PlaneMatch& m : a.matches) {
     std::snprintf(buf, sizeof(buf), "%6d  %7d  %4d  %11.3f  %10.2f  %5s\n",
@@ -127,8 +149,9 @@ std::string FormatTable(const StructureAccuracy& a) {
                   m.offset_error_m * 1e3, m.matched ? "yes" : "no");
     out += buf;
   }
-  out += "  true  landmarks  observed  matched  best fitted  normal(deg)  "
-         "offset(mm)\n";
+  out +=
+      "  true  landmarks  observed  matched  best fitted  normal(deg)  "
+      "offset(mm)\n";
   for (const TruePlaneResult& t : a.true_plane_results) {
     if (t.best_fitted_id >= 0) {
       std::snprintf(buf, sizeof(buf),

@@ -3,11 +3,11 @@
 // ErrorStats -> {count, mean, median, p90, max, rms}.
 #pragma once
 
+#include <nlohmann/json.hpp>
 #include <string>
 
-#include <nlohmann/json.hpp>
-
 #include "monomap/eval/point_accuracy.h"
+#include "monomap/eval/render_fidelity.h"
 #include "monomap/eval/structure_accuracy.h"
 #include "monomap/eval/trajectory_metrics.h"
 
@@ -29,10 +29,15 @@ nlohmann::json ToJson(const TrajectoryErrors& errors);
 //                   best_fitted_id, normal_error_deg, offset_error_m}]}
 // (errors of a true plane without a fitted plane are null).
 nlohmann::json ToJson(const StructureAccuracy& accuracy);
+// {"compared": n, "skipped": n, "ncc": {...}, "psnr_db": {...},
+//  "coverage": {...}, "frames": [{frame, coverage, ncc, psnr_db}]}
+nlohmann::json ToJson(const RenderFidelity& fidelity);
 
 // Fixed-width tables, one row per quantity, columns count mean median p90
 // max rms; each ends with a newline. Point errors in mm and %.
 std::string FormatTable(const PointAccuracy& accuracy);
+// NCC, PSNR (dB) and coverage (%) over the compared frames, and counts.
+std::string FormatTable(const RenderFidelity& fidelity);
 // Translation in mm, rotation in degrees, plus the matched count and scale.
 std::string FormatTable(const TrajectoryErrors& errors);
 // Counts, precision and recall, point errors (mm and %), then one row per

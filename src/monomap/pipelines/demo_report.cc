@@ -5,11 +5,10 @@
 #include <cstdio>
 #include <limits>
 #include <map>
-#include <sstream>
-#include <utility>
-
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <sstream>
+#include <utility>
 
 #include "monomap/eval/report_json.h"
 #include "monomap/io/dataset.h"
@@ -34,8 +33,8 @@ void DemoOptions::Check() const {
   CheckOption(width >= 64 && height >= 48, "width/height",
               "must be at least 64x48");
   structure.Check();
-  CheckOption(rpe_delta_frames >= 1, "rpe_delta_frames",
-              "must be at least 1");
+  CheckOption(rpe_delta_frames >= 1, "rpe_delta_frames", "must be at least 1");
+  if (localization.enabled) localization.Check();
 }
 
 namespace {
@@ -92,11 +91,20 @@ std::string HtmlEscape(const std::string& s) {
   std::string out;
   for (char c : s) {
     switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      default:
+        out += c;
     }
   }
   return out;
@@ -111,12 +119,18 @@ cv::Vec3d Hue(double h) {
   const double f = x - std::floor(x);
   const double p = 0.0, q = v * (1 - f), t = v * f;
   switch (i) {
-    case 0: return {v, t, p};
-    case 1: return {q, v, p};
-    case 2: return {p, v, t};
-    case 3: return {p, q, v};
-    case 4: return {t, p, v};
-    default: return {v, p, q};
+    case 0:
+      return {v, t, p};
+    case 1:
+      return {q, v, p};
+    case 2:
+      return {p, v, t};
+    case 3:
+      return {p, q, v};
+    case 4:
+      return {t, p, v};
+    default:
+      return {v, p, q};
   }
 }
 
@@ -225,9 +239,9 @@ class SvgPlot {
   void Marker(const Eigen::Vector2d& p, const std::string& colour,
               const std::string& text) {
     body_ << "<circle cx=\"" << X(p.x()) << "\" cy=\"" << Y(p.y())
-          << "\" r=\"4\" fill=\"" << colour << "\"/><text x=\""
-          << X(p.x()) + 6 << "\" y=\"" << Y(p.y()) - 6
-          << "\" font-size=\"11\">" << HtmlEscape(text) << "</text>\n";
+          << "\" r=\"4\" fill=\"" << colour << "\"/><text x=\"" << X(p.x()) + 6
+          << "\" y=\"" << Y(p.y()) - 6 << "\" font-size=\"11\">"
+          << HtmlEscape(text) << "</text>\n";
   }
 
   // Legend entries (colour, text) in the top-right corner.
@@ -249,8 +263,7 @@ class SvgPlot {
       << "\" height=\"" << height_ << "\" viewBox=\"0 0 " << width_ << " "
       << height_ << "\" font-family=\"sans-serif\">\n";
     s << "<rect x=\"" << kLeft << "\" y=\"" << kTop << "\" width=\""
-      << width_ - kLeft - kRight << "\" height=\""
-      << height_ - kTop - kBottom
+      << width_ - kLeft - kRight << "\" height=\"" << height_ - kTop - kBottom
       << "\" fill=\"#fbfbfb\" stroke=\"#999\"/>\n";
     // Ticks and grid.
     const double xs = TickStep(b_.x1 - b_.x0), ys = TickStep(b_.y1 - b_.y0);
@@ -317,8 +330,8 @@ std::vector<Eigen::Vector2d> PerFramePositionError(
     const std::vector<TimedPose>& aligned_estimate,
     const std::vector<TimedPose>& groundtruth) {
   std::vector<Eigen::Vector2d> out;
-  for (const auto& [e, g] : AssociateByTimestamp(aligned_estimate,
-                                                 groundtruth)) {
+  for (const auto& [e, g] :
+       AssociateByTimestamp(aligned_estimate, groundtruth)) {
     out.emplace_back(static_cast<double>(g),
                      (aligned_estimate[e].world_from_cam.translation -
                       groundtruth[g].world_from_cam.translation)
@@ -354,8 +367,8 @@ cv::Mat UndistortTo(const cv::Mat& raw, const Camera& camera,
     for (int u = 0; u < pinhole.width; ++u) {
       const Eigen::Vector2d xn((u - pinhole.cx) / pinhole.fx,
                                (v - pinhole.cy) / pinhole.fy);
-      const Eigen::Vector2d px = camera.PinholeFromNormalized(
-          camera.Distort(xn));
+      const Eigen::Vector2d px =
+          camera.PinholeFromNormalized(camera.Distort(xn));
       map_x.at<float>(v, u) = static_cast<float>(px.x());
       map_y.at<float>(v, u) = static_cast<float>(px.y());
     }
@@ -365,8 +378,8 @@ cv::Mat UndistortTo(const cv::Mat& raw, const Camera& camera,
   return out;
 }
 
-std::string StatsRow(const std::string& name, const ErrorStats& s,
-                     double scale, const char* format) {
+std::string StatsRow(const std::string& name, const ErrorStats& s, double scale,
+                     const char* format) {
   std::string row = "<tr><td>" + HtmlEscape(name) + "</td><td>" +
                     std::to_string(s.count) + "</td>";
   for (double v : {s.mean, s.median, s.p90, s.max, s.rms}) {
@@ -378,6 +391,143 @@ std::string StatsRow(const std::string& name, const ErrorStats& s,
 const char* kStatsHeader =
     "<tr><th></th><th>count</th><th>mean</th><th>median</th><th>p90</th>"
     "<th>max</th><th>rms</th></tr>\n";
+
+// The localization section: figures of both methods, the map's texture
+// fidelity on the traversal, error and particle count per update, and the
+// particles converging (top views at a few updates).
+std::string LocalizationSection(const DemoLocalization& loc,
+                                const DemoLocalizationOptions& options) {
+  static const char* kColours[] = {"#d62728", "#1f77b4"};
+  std::ostringstream h;
+  h << "<h2 id=\"localization\">Localization</h2>\n<p class=\"note\">A "
+       "second traversal of the same world ("
+    << loc.frames << " frames, other odometry errors and image noise, "
+    << Fmt("%g", options.start_offset_m) << " m into the mapped path and "
+    << Fmt("%g", options.lateral_offset_m)
+    << " m beside it), localized in the map from a global initialisation "
+       "(particles over the whole mapped area, planar state) with plain "
+       "Monte Carlo Localization and with Monte Carlo Correction, both with "
+       "a budget of "
+    << options.particles << " particles. Localized = position within "
+    << Fmt("%g", options.accuracy.max_translation_error_m * 100)
+    << " cm and heading within "
+    << Fmt("%g", options.accuracy.max_rotation_error_deg)
+    << "&deg; of the ground truth. One run with the demo's seed; the success "
+       "rates over 20 seeds are in docs/benchmarks.md.</p>\n";
+  h << "<table><tr><th>method</th><th>localized at the end</th>"
+       "<th>converged at update</th><th>final error</th>"
+       "<th>mean error after convergence</th><th>updates localized</th>"
+       "<th>mean particles</th><th>ms per update</th></tr>\n";
+  for (const DemoLocalizationRun& r : loc.runs) {
+    const LocalizationAccuracy& a = r.accuracy;
+    h << "<tr><td>" << r.name << "</td><td class=\""
+      << (a.success ? "ok\">yes" : "bad\">no") << "</td><td>"
+      << (a.converged_step >= 0 ? std::to_string(a.converged_step) : "-")
+      << "</td><td>" << Fmt("%.1f cm", 100 * a.final_translation_error_m)
+      << ", " << Fmt("%.2f&deg;", a.final_rotation_error_deg) << "</td><td>"
+      << (a.success ? Fmt("%.1f cm", 100 * a.mean_translation_error_m) + ", " +
+                          Fmt("%.2f&deg;", a.mean_rotation_error_deg)
+                    : std::string("-"))
+      << "</td><td>" << Fmt("%.0f%%", 100 * a.fraction_within) << "</td><td>"
+      << Fmt("%.0f", r.report.mean_particles) << "</td><td>"
+      << Fmt("%.1f", 1e3 * r.report.mean_step_seconds) << "</td></tr>\n";
+  }
+  h << "</table>\n";
+
+  const RenderFidelity& f = loc.fidelity;
+  h << "<h3>Texture fidelity</h3>\n<p class=\"note\">The map rendered from "
+       "the traversal's ground-truth poses (which the map was not built "
+       "from) against the real images, every "
+    << options.fidelity_stride
+    << "th frame, over the pixels the map covers: " << f.frames.size()
+    << " frames compared, " << f.skipped << " skipped (map covers less than "
+    << Fmt("%.0f%%", 100 * options.fidelity.min_coverage)
+    << "). PSNR after a least-squares gain and offset.</p>\n<table>"
+    << kStatsHeader << StatsRow("NCC", f.ncc, 1, "%.3f")
+    << StatsRow("PSNR (dB)", f.psnr_db, 1, "%.1f")
+    << StatsRow("coverage (%)", f.coverage, 100, "%.0f") << "</table>\n";
+
+  // Error and particle count per update.
+  Bounds eb, pb;
+  eb.Add(0, 0);
+  pb.Add(0, 0);
+  std::vector<std::vector<Eigen::Vector2d>> err(loc.runs.size()),
+      count(loc.runs.size());
+  for (size_t m = 0; m < loc.runs.size(); ++m) {
+    const LocalizationAccuracy& a = loc.runs[m].accuracy;
+    for (size_t i = 0; i < a.step.size(); ++i) {
+      // Capped so that the converged part stays readable.
+      const double cm = std::min(100.0, 100 * a.translation_error_m[i]);
+      err[m].emplace_back(a.step[i], cm);
+      eb.Add(a.step[i], cm);
+    }
+    const auto& steps = loc.runs[m].report.steps;
+    for (size_t i = 0; i < steps.size(); ++i) {
+      count[m].emplace_back(i, steps[i].particles);
+      pb.Add(i, steps[i].particles);
+    }
+  }
+  SvgPlot err_plot(eb, 660, 300, false, "update",
+                   "position error (cm, capped at 100)");
+  SvgPlot count_plot(pb, 660, 300, false, "update", "particles");
+  std::vector<std::pair<std::string, std::string>> legend;
+  for (size_t m = 0; m < loc.runs.size(); ++m) {
+    err_plot.Line(err[m], kColours[m % 2], 1.5);
+    count_plot.Line(count[m], kColours[m % 2], 1.5);
+    legend.emplace_back(kColours[m % 2], loc.runs[m].name);
+  }
+  err_plot.Legend(legend);
+  count_plot.Legend(legend);
+  h << "<div class=\"row\"><figure>" << err_plot.Finish()
+    << "<figcaption>Position error of the estimate per update."
+       "</figcaption></figure><figure>"
+    << count_plot.Finish()
+    << "<figcaption>Particles alive per update (KLD-sampling; MCC merges "
+       "duplicates).</figcaption></figure></div>\n";
+
+  // Top views of the particles at a few updates.
+  Bounds area;
+  for (const DemoLocalizationRun& r : loc.runs) {
+    if (r.particles_xy.empty()) continue;
+    for (const auto& p : r.particles_xy.front()) area.Add(p.x(), p.y());
+  }
+  for (const TimedPose& g : loc.groundtruth) {
+    area.Add(g.world_from_cam.translation.x(),
+             g.world_from_cam.translation.y());
+  }
+  std::vector<Eigen::Vector2d> path;
+  for (const TimedPose& g : loc.groundtruth) {
+    path.emplace_back(g.world_from_cam.translation.head<2>());
+  }
+  for (size_t m = 0; m < loc.runs.size(); ++m) {
+    const DemoLocalizationRun& r = loc.runs[m];
+    const int n = static_cast<int>(r.particles_xy.size());
+    if (n == 0) continue;
+    std::vector<int> shown = {0, 2, 5, 15, n - 1};
+    shown.erase(std::remove_if(shown.begin(), shown.end(),
+                               [&](int s) { return s >= n; }),
+                shown.end());
+    shown.erase(std::unique(shown.begin(), shown.end()), shown.end());
+    h << "<h3>" << r.name << ": particles (camera positions, top view)</h3>\n"
+      << "<div class=\"row\">\n";
+    for (int s : shown) {
+      SvgPlot plot(area, 330, 330, true, "x (m)", "y (m)");
+      plot.Line(path, "#bbb", 1.0);
+      const std::vector<int> labels(r.particles_xy[s].size(),
+                                    static_cast<int>(m));
+      plot.Dots(r.particles_xy[s], labels, 1.3);
+      if (s < static_cast<int>(loc.groundtruth.size())) {
+        plot.Marker(loc.groundtruth[s].world_from_cam.translation.head<2>(),
+                    "#000", "truth");
+      }
+      h << "<figure>" << plot.Finish() << "<figcaption>Update " << s << ": "
+        << r.report.steps[s].particles << " particles"
+        << "</figcaption></figure>\n";
+    }
+    h << "</div>\n";
+  }
+  return h.str();
+}
 
 const char* kCss = R"(
 body{font-family:sans-serif;margin:24px auto;max-width:1400px;color:#222;
@@ -446,9 +596,11 @@ nlohmann::json DemoReport::ToJson() const {
                      {"rpe_refined", monomap::ToJson(rpe_refined)},
                      {"rpe_odometry", monomap::ToJson(rpe_odometry)}};
   j["mapping"] = mapping;
+  if (!localization.runs.empty()) j["localization"] = localization.ToJson();
   j["timings_seconds"] = {{"simulate", simulate_seconds},
                           {"mapping", mapping_seconds},
                           {"evaluation", evaluation_seconds},
+                          {"localization", localization.seconds},
                           {"report", report_seconds},
                           {"total", total_seconds}};
   return j;
@@ -532,16 +684,24 @@ DemoReport RunDemo(const DemoOptions& options) {
                                                Alignment::kFirstPose);
   report.ate_odometry =
       AbsoluteTrajectoryError(odometry, groundtruth, Alignment::kFirstPose);
-  const int delta = std::min(options.rpe_delta_frames,
-                             std::max(1, report.frames - 1));
+  const int delta =
+      std::min(options.rpe_delta_frames, std::max(1, report.frames - 1));
   report.rpe_refined = RelativePoseError(map.trajectory, groundtruth, delta);
   report.rpe_odometry = RelativePoseError(odometry, groundtruth, delta);
   const std::vector<TimedPose> refined_aligned = AlignedPoses(
-      map.trajectory, AlignTrajectories(map.trajectory, groundtruth,
-                                        Alignment::kFirstPose));
+      map.trajectory,
+      AlignTrajectories(map.trajectory, groundtruth, Alignment::kFirstPose));
   const std::vector<TimedPose> odometry_aligned =
       AlignedPoses(odometry, world_from_map);
   report.evaluation_seconds = eval_timer.ElapsedSeconds();
+
+  // 3c. A second traversal localized in the map.
+  if (options.localization.enabled) {
+    say("localizing a second traversal (MCL and MCC, global start)");
+    report.localization =
+        RunDemoLocalization(map, sim, world_from_map.rigid.Inverse(),
+                            options.localization, dir / "localization_dataset");
+  }
 
   // 4. Figures and the page.
   say("writing the report");
@@ -553,8 +713,8 @@ DemoReport RunDemo(const DemoOptions& options) {
     << HtmlEscape(options.world) << "</title><style>" << kCss
     << "</style></head>\n<body>\n";
   h << "<h1>monomap demo: " << HtmlEscape(options.world) << "</h1>\n"
-    << "<p class=\"note\">Simulated " << n << " frames of "
-    << options.width << "x" << options.height << " (seed " << options.seed
+    << "<p class=\"note\">Simulated " << n << " frames of " << options.width
+    << "x" << options.height << " (seed " << options.seed
     << "), built a map from the images and the odometry only, and compared "
        "it with the simulator's exact ground truth. Dataset: <code>"
     << HtmlEscape(report.dataset_dir.string()) << "</code>, map: <code>"
@@ -642,9 +802,8 @@ DemoReport RunDemo(const DemoOptions& options) {
     robust_range(2, &z0, &z1);
     // Side view along the longer horizontal axis.
     const int side_axis = (x1 - x0) >= (y1 - y0) ? 0 : 1;
-    auto view = [&](int ax, int ay, double a0, double a1, double b0,
-                    double b1, const std::string& lx, const std::string& ly,
-                    int max_h) {
+    auto view = [&](int ax, int ay, double a0, double a1, double b0, double b1,
+                    const std::string& lx, const std::string& ly, int max_h) {
       Bounds b;
       b.Add(a0, b0);
       b.Add(a1, b1);
@@ -683,9 +842,8 @@ DemoReport RunDemo(const DemoOptions& options) {
       << "<figcaption>Top view (x-y). Black: refined camera path; dashed: "
          "true planes. Colour: plane label, grey: on no plane."
          "</figcaption></figure>\n<figure>"
-      << view(side_axis, 2, side_axis == 0 ? x0 : y0,
-              side_axis == 0 ? x1 : y1, z0, z1,
-              side_axis == 0 ? "x (m)" : "y (m)", "z (m)", 400)
+      << view(side_axis, 2, side_axis == 0 ? x0 : y0, side_axis == 0 ? x1 : y1,
+              z0, z1, side_axis == 0 ? "x (m)" : "y (m)", "z (m)", 400)
       << "<figcaption>Side view (" << (side_axis == 0 ? "x" : "y")
       << "-z).</figcaption></figure></div>\n";
     h << "<p>";
@@ -704,9 +862,8 @@ DemoReport RunDemo(const DemoOptions& options) {
     cv::Mat tex = p.texture;
     if (tex.cols > 512) {
       const double s = 512.0 / tex.cols;
-      cv::resize(tex, tex,
-                 cv::Size(512, std::max(1, cvRound(tex.rows * s))), 0, 0,
-                 cv::INTER_AREA);
+      cv::resize(tex, tex, cv::Size(512, std::max(1, cvRound(tex.rows * s))), 0,
+                 0, cv::INTER_AREA);
     }
     const PlaneMatch* m = nullptr;
     for (const auto& pm : structure.matches) {
@@ -715,10 +872,9 @@ DemoReport RunDemo(const DemoOptions& options) {
     h << "<figure><div class=\"tex\" style=\"display:inline-block\">"
       << ImgTag(tex, "texture of plane " + std::to_string(p.id))
       << "</div><figcaption><span style=\"color:" << LabelColor(p.id)
-      << "\">&#9632;</span> Plane " << p.id << ": "
-      << p.texture.cols << "x" << p.texture.rows << " texels at "
-      << Fmt("%.0f", p.pixels_per_meter) << " px/m"
-      << (m ? ", " + std::to_string(m->inliers) + " points" : "")
+      << "\">&#9632;</span> Plane " << p.id << ": " << p.texture.cols << "x"
+      << p.texture.rows << " texels at " << Fmt("%.0f", p.pixels_per_meter)
+      << " px/m" << (m ? ", " + std::to_string(m->inliers) + " points" : "")
       << "</figcaption></figure>\n";
   }
   h << "</div>\n";
@@ -747,9 +903,8 @@ DemoReport RunDemo(const DemoOptions& options) {
       } else {
         stats = renderer.Render(small, pose, &render);
       }
-      const cv::Mat real =
-          UndistortTo(dataset.LoadImage(f, ropt.enable_color), dataset.camera,
-                      small);
+      const cv::Mat real = UndistortTo(dataset.LoadImage(f, ropt.enable_color),
+                                       dataset.camera, small);
       cv::Mat real_grey = real, render_grey = render;
       if (real.channels() == 3) {
         cv::cvtColor(real, real_grey, cv::COLOR_BGR2GRAY);
@@ -783,8 +938,8 @@ DemoReport RunDemo(const DemoOptions& options) {
     << "<table>" << kStatsHeader
     << StatsRow("all landmarks (mm)", structure.point_error_all.absolute_m,
                 1000, "%.1f")
-    << StatsRow("all landmarks (%)",
-                structure.point_error_all.relative_percent, 1, "%.2f")
+    << StatsRow("all landmarks (%)", structure.point_error_all.relative_percent,
+                1, "%.2f")
     << StatsRow("on a fitted plane (mm)",
                 structure.point_error_on_planes.absolute_m, 1000, "%.1f")
     << StatsRow("on a fitted plane (%)",
@@ -798,9 +953,9 @@ DemoReport RunDemo(const DemoOptions& options) {
     << structure.true_planes << " true planes, "
     << structure.observed_true_planes << " observed (&ge; "
     << options.structure.min_observed_landmarks << " landmarks within "
-    << Fmt("%g", options.structure.observed_distance_m * 100)
-    << " cm). Recall " << Fmt("%.0f%%", 100 * structure.recall)
-    << ", precision " << Fmt("%.0f%%", 100 * structure.precision)
+    << Fmt("%g", options.structure.observed_distance_m * 100) << " cm). Recall "
+    << Fmt("%.0f%%", 100 * structure.recall) << ", precision "
+    << Fmt("%.0f%%", 100 * structure.precision)
     << ".</p>\n<table><tr><th>fitted plane</th><th>points</th><th>true "
        "plane</th><th>normal error (&deg;)</th><th>offset error "
        "(mm)</th><th>match</th></tr>\n";
@@ -869,29 +1024,45 @@ DemoReport RunDemo(const DemoOptions& options) {
     h << "<div class=\"row\"><figure>" << traj.Finish()
       << "<figcaption>Camera path, top view (first pose aligned"
       << (equal ? "" : "; axes scaled differently") << ").</figcaption>"
-      << "</figure><figure>"
-      << err.Finish()
+      << "</figure><figure>" << err.Finish()
       << "<figcaption>Position error per frame.</figcaption></figure></div>\n";
   }
 
-  // (f) Timing.
+  // (f) Localization.
+  if (!report.localization.runs.empty()) {
+    h << LocalizationSection(report.localization, options.localization);
+  }
+
+  // (g) Timing.
   report.report_seconds = report_timer.ElapsedSeconds();
-  h << "<h2 id=\"timing\">Timing</h2>\n<table><tr><th>stage</th><th>seconds</th></tr>\n"
+  h << "<h2 "
+       "id=\"timing\">Timing</h2>\n<table><tr><th>stage</th><th>seconds</th></"
+       "tr>\n"
     << "<tr><td>simulate</td><td>" << Fmt("%.2f", report.simulate_seconds)
     << "</td></tr>\n";
   const nlohmann::json& timings = report.mapping["timings_seconds"];
   for (const StageTiming& s : result.report.timings) {
-    const double sec = timings.contains(s.name)
-                           ? timings[s.name].get<double>()
-                           : s.seconds;
+    const double sec =
+        timings.contains(s.name) ? timings[s.name].get<double>() : s.seconds;
     h << "<tr><td>&nbsp;&nbsp;map: " << HtmlEscape(s.name) << "</td><td>"
       << Fmt("%.2f", sec) << "</td></tr>\n";
   }
   h << "<tr><td>map (total, with writing)</td><td>"
     << Fmt("%.2f", report.mapping_seconds) << "</td></tr>\n"
     << "<tr><td>evaluation</td><td>" << Fmt("%.2f", report.evaluation_seconds)
-    << "</td></tr>\n<tr><td>report figures</td><td>"
-    << Fmt("%.2f", report.report_seconds) << "</td></tr>\n"
+    << "</td></tr>\n";
+  if (!report.localization.runs.empty()) {
+    const DemoLocalization& loc = report.localization;
+    h << "<tr><td>localization: simulate the traversal</td><td>"
+      << Fmt("%.2f", loc.simulate_seconds) << "</td></tr>\n";
+    for (const DemoLocalizationRun& run : loc.runs) {
+      h << "<tr><td>&nbsp;&nbsp;localization: " << run.name << " ("
+        << run.report.frames << " updates)</td><td>"
+        << Fmt("%.2f", run.report.seconds) << "</td></tr>\n";
+    }
+  }
+  h << "<tr><td>report figures</td><td>" << Fmt("%.2f", report.report_seconds)
+    << "</td></tr>\n"
     << "<tr><td><b>total</b></td><td><b>"
     << Fmt("%.2f", total_timer.ElapsedSeconds())
     << "</b></td></tr>\n</table>\n";

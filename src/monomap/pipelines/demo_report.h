@@ -6,19 +6,20 @@
 // Output directory layout:
 //   DIR/dataset/      the simulated dataset (with structure/ = true planes)
 //   DIR/map/          the built map (see io/map_format.h)
+//   DIR/localization_dataset/  a second traversal, localized in the map
 //   DIR/report.html   the report
 //   DIR/report.json   every figure of the report
 #pragma once
 
 #include <cstdint>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
-#include <nlohmann/json.hpp>
-
 #include "monomap/eval/structure_accuracy.h"
 #include "monomap/eval/trajectory_metrics.h"
+#include "monomap/pipelines/demo_localization.h"
 
 namespace monomap {
 
@@ -39,6 +40,9 @@ struct DemoOptions {
   StructureAccuracyOptions structure;
   // Frame offset of the relative pose error (30 frames = 1 s at 30 Hz).
   int rpe_delta_frames = 30;
+  // The second traversal localized in the map (MCL and MCC from a global
+  // initialisation) and the map's texture fidelity on it.
+  DemoLocalizationOptions localization;
   // Draw progress bars and stage messages on stderr.
   bool show_progress = true;
 
@@ -64,6 +68,9 @@ struct DemoReport {
   TrajectoryErrors ate_odometry;
   TrajectoryErrors rpe_refined;
   TrajectoryErrors rpe_odometry;
+
+  // The localization part (empty runs if disabled).
+  DemoLocalization localization;
 
   // Mapping report (counts and per-stage timings).
   nlohmann::json mapping;

@@ -44,10 +44,10 @@ class ThumbnailCache {
   Eigen::Vector3f ColorAt(int frame, const Eigen::Vector2d& px) const {
     const cv::Mat& t = thumbs_[frame];
     if (t.empty()) return Eigen::Vector3f::Zero();
-    const int c = std::clamp(static_cast<int>((px.x() + 0.5) / kScale), 0,
-                             t.cols - 1);
-    const int r = std::clamp(static_cast<int>((px.y() + 0.5) / kScale), 0,
-                             t.rows - 1);
+    const int c =
+        std::clamp(static_cast<int>((px.x() + 0.5) / kScale), 0, t.cols - 1);
+    const int r =
+        std::clamp(static_cast<int>((px.y() + 0.5) / kScale), 0, t.rows - 1);
     const cv::Vec3b bgr = t.at<cv::Vec3b>(r, c);
     return Eigen::Vector3f(bgr[2], bgr[1], bgr[0]);
   }
@@ -85,7 +85,8 @@ BundleAdjustmentReport BundleAdjustKeyframes(
     Track kt;
     kt.id = t.id;
     for (const Observation& o : t.observations) {
-      if (key_index[o.frame] >= 0) kt.observations.push_back({key_index[o.frame], o.px});
+      if (key_index[o.frame] >= 0)
+        kt.observations.push_back({key_index[o.frame], o.px});
     }
     if (kt.observations.size() >= 3) {
       usable[t.id] = key_tracks.size();
@@ -152,8 +153,7 @@ MappingResult BuildMap(const Dataset& dataset, const MappingOptions& options) {
   }
   report.timings.push_back({"tracking", timer.ElapsedSeconds()});
   if (result.tracks.empty()) {
-    throw StageError("tracking found no features in " +
-                     dataset.root.string());
+    throw StageError("tracking found no features in " + dataset.root.string());
   }
 
   // Stage 2: triangulation with odometry poses, then bundle adjustment.
@@ -174,13 +174,13 @@ MappingResult BuildMap(const Dataset& dataset, const MappingOptions& options) {
     loose.max_reprojection_error_px *= options.first_pass_error_factor;
     loose.max_observation_error_px *= options.first_pass_error_factor;
   }
-  report.triangulation =
-      TriangulateTracks(camera, world_from_cam, result.tracks, loose,
-                        &landmarks);
+  report.triangulation = TriangulateTracks(camera, world_from_cam,
+                                           result.tracks, loose, &landmarks);
   report.timings.push_back({"triangulation", timer.ElapsedSeconds()});
   if (landmarks.empty()) {
-    throw StageError("no track could be triangulated (too little motion or "
-                     "too few features?)");
+    throw StageError(
+        "no track could be triangulated (too little motion or "
+        "too few features?)");
   }
   timer.Restart();
   if (options.bundle_adjustment.enabled) {
@@ -280,8 +280,7 @@ nlohmann::json MappingReport::ToJson() const {
       {"points_joint", bundle_adjustment.num_points_joint},
       {"initial_rms_reprojection_error_px",
        bundle_adjustment.initial_rms_error_px},
-      {"final_rms_reprojection_error_px",
-       bundle_adjustment.final_rms_error_px},
+      {"final_rms_reprojection_error_px", bundle_adjustment.final_rms_error_px},
       {"initial_median_reprojection_error_px",
        bundle_adjustment.initial_median_error_px},
       {"final_median_reprojection_error_px",
@@ -290,10 +289,11 @@ nlohmann::json MappingReport::ToJson() const {
       {"points_dropped", bundle_adjustment.num_dropped},
       {"mean_pose_change_m", bundle_adjustment.mean_pose_change_m},
       {"mean_pose_change_deg", bundle_adjustment.mean_pose_change_deg}};
-  nlohmann::json planes_json = {{"planes", planes.num_planes},
-                                {"outliers", planes.num_outliers},
-                                {"absorbed_outliers", planes.absorbed},
-                                {"inliers_per_plane", planes.inliers_per_plane}};
+  nlohmann::json planes_json = {
+      {"planes", planes.num_planes},
+      {"outliers", planes.num_outliers},
+      {"absorbed_outliers", planes.absorbed},
+      {"inliers_per_plane", planes.inliers_per_plane}};
   j["planes"] = planes_json;
   j["homographies"] = {
       {"count", homographies.num_homographies},
@@ -303,24 +303,23 @@ nlohmann::json MappingReport::ToJson() const {
       {"median_residual_after_px", homographies.median_residual_after_px}};
   nlohmann::json mosaics = nlohmann::json::array();
   for (const auto& m : mosaic.planes) {
-    mosaics.push_back({{"plane_id", m.plane_id},
-                       {"pixels_per_meter", m.pixels_per_meter},
-                       {"width", m.width},
-                       {"height", m.height},
-                       {"frames", m.frames},
-                       {"coverage", m.coverage},
-                       {"features", m.num_features},
-                       {"feature_residual_median_px",
-                        m.feature_residual_median_px},
-                       {"feature_residual_max_px", m.feature_residual_max_px}});
+    mosaics.push_back(
+        {{"plane_id", m.plane_id},
+         {"pixels_per_meter", m.pixels_per_meter},
+         {"width", m.width},
+         {"height", m.height},
+         {"frames", m.frames},
+         {"coverage", m.coverage},
+         {"features", m.num_features},
+         {"feature_residual_median_px", m.feature_residual_median_px},
+         {"feature_residual_max_px", m.feature_residual_max_px}});
   }
   j["mosaics"] = mosaics;
   nlohmann::json t = nlohmann::json::object();
   for (const auto& s : timings) t[s.name] = s.seconds;
   j["timings_seconds"] = t;
   j["total_seconds"] = total_seconds;
-  j["frames_per_second"] =
-      total_seconds > 0 ? num_frames / total_seconds : 0.0;
+  j["frames_per_second"] = total_seconds > 0 ? num_frames / total_seconds : 0.0;
   return j;
 }
 
