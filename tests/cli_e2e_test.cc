@@ -1,14 +1,15 @@
 // The `monomap` binary: exit codes, error messages and atomic output.
 #include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <array>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <nlohmann/json.hpp>
 #include <string>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include "monomap/io/map_format.h"
 #include "monomap/sim/simulate.h"
@@ -40,7 +41,8 @@ RunResult RunMonomap(const std::string& args) {
 class Cli : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    root_ = new fs::path(fs::temp_directory_path() / ("monomap_cli_test_" + std::to_string(getpid())));
+    root_ = new fs::path(fs::temp_directory_path() /
+                         ("monomap_cli_test_" + std::to_string(getpid())));
     fs::remove_all(*root_);
     fs::create_directories(*root_);
     SimulationOptions sim;
@@ -67,9 +69,9 @@ fs::path* Cli::root_ = nullptr;
 
 TEST_F(Cli, BuildWritesAReadableMap) {
   const fs::path out = *root_ / "map_ok";
-  const RunResult r = RunMonomap("build " + (*root_ / "data").string() + " -o " +
-                          out.string() + " -q --report " +
-                          (*root_ / "report.json").string());
+  const RunResult r =
+      RunMonomap("build " + (*root_ / "data").string() + " -o " + out.string() +
+                 " -q --report " + (*root_ / "report.json").string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const Map map = ReadMap(out);
   EXPECT_EQ(map.trajectory.size(), 40u);
@@ -89,13 +91,11 @@ TEST_F(Cli, MalformedOdometryLineIsNamedAndNothingIsWritten) {
       RunMonomap("build " + data.string() + " -o " + out.string() + " -q");
   EXPECT_EQ(r.exit_code, 1) << r.output;
   EXPECT_NE(r.output.find("odometry.txt:"), std::string::npos) << r.output;
-  EXPECT_NE(r.output.find("expected 8 values"), std::string::npos)
-      << r.output;
+  EXPECT_NE(r.output.find("expected 8 values"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(out));
   // No temporary directory is left behind either.
   for (const auto& e : fs::directory_iterator(*root_)) {
-    EXPECT_EQ(e.path().filename().string().find(".map_bad"),
-              std::string::npos);
+    EXPECT_EQ(e.path().filename().string().find(".map_bad"), std::string::npos);
   }
 }
 
@@ -103,7 +103,7 @@ TEST_F(Cli, MissingImageAndWrongSizeAreNamed) {
   const fs::path data = CopyData("bad_image");
   fs::remove(data / "rgb" / "000003.png");
   RunResult r = RunMonomap("build " + data.string() + " -o " +
-                    (*root_ / "m").string() + " -q");
+                           (*root_ / "m").string() + " -q");
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.output.find("rgb.txt:"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("not found"), std::string::npos) << r.output;
@@ -123,8 +123,8 @@ TEST_F(Cli, MissingDatasetIsNamed) {
 TEST_F(Cli, EvalStructurePrintsTheTableAndWritesJson) {
   const fs::path data = *root_ / "data";
   const fs::path map = *root_ / "map_structure";
-  RunResult r = RunMonomap("build " + data.string() + " -o " + map.string() +
-                           " -q");
+  RunResult r =
+      RunMonomap("build " + data.string() + " -o " + map.string() + " -q");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const fs::path json = *root_ / "structure.json";
   r = RunMonomap("eval structure " + map.string() + " --structure " +
@@ -134,8 +134,7 @@ TEST_F(Cli, EvalStructurePrintsTheTableAndWritesJson) {
             std::string::npos)
       << r.output;
   EXPECT_NE(r.output.find("plane precision"), std::string::npos) << r.output;
-  EXPECT_NE(r.output.find("on planes rel (%)"), std::string::npos)
-      << r.output;
+  EXPECT_NE(r.output.find("on planes rel (%)"), std::string::npos) << r.output;
   std::ifstream in(json);
   const std::string text((std::istreambuf_iterator<char>(in)),
                          std::istreambuf_iterator<char>());
@@ -145,8 +144,7 @@ TEST_F(Cli, EvalStructurePrintsTheTableAndWritesJson) {
     EXPECT_NE(text.find(key), std::string::npos) << key << "\n" << text;
   }
   // Relative errors use the depths from features.csv, not 0.
-  EXPECT_NE(text.find("mean_distance_to_observing_cameras"),
-            std::string::npos);
+  EXPECT_NE(text.find("mean_distance_to_observing_cameras"), std::string::npos);
 
   r = RunMonomap("eval structure " + map.string() + " --structure " +
                  (data / "structure").string() +
@@ -163,8 +161,7 @@ TEST_F(Cli, EvalStructureErrorsNameThePath) {
   RunResult r = RunMonomap("eval structure /nonexistent/map --structure " +
                            (data / "structure").string());
   EXPECT_EQ(r.exit_code, 1) << r.output;
-  EXPECT_NE(r.output.find("/nonexistent/map"), std::string::npos)
-      << r.output;
+  EXPECT_NE(r.output.find("/nonexistent/map"), std::string::npos) << r.output;
   r = RunMonomap("eval structure " + (data / "structure").string() +
                  " --structure /nonexistent/structure");
   EXPECT_EQ(r.exit_code, 1) << r.output;
@@ -181,7 +178,42 @@ TEST_F(Cli, EvalStructureErrorsNameThePath) {
                        " --align sim3")
                 .exit_code,
             2);
-  EXPECT_EQ(RunMonomap("eval structure " + (data / "structure").string())
+  EXPECT_EQ(
+      RunMonomap("eval structure " + (data / "structure").string()).exit_code,
+      2);
+}
+
+// Texture fidelity on held-out frames: a map of the first 30 frames
+// rendered from the true poses of the last 10 matches their images.
+TEST_F(Cli, EvalRenderComparesHeldOutFrames) {
+  const fs::path data = *root_ / "data";
+  const fs::path map = *root_ / "map_render";
+  RunResult r = RunMonomap("build " + data.string() + " --frames 30 -o " +
+                           map.string() + " -q");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const fs::path json = *root_ / "render.json";
+  r = RunMonomap("eval render " + map.string() + " " + data.string() +
+                 " --first-frame 30 --stride 2 --json " + json.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("texture fidelity (alignment none)"),
+            std::string::npos)
+      << r.output;
+  std::ifstream in(json);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_EQ(j["compared"].get<int>() + j["skipped"].get<int>(), 5);
+  EXPECT_GE(j["compared"].get<int>(), 3);
+  EXPECT_GT(j["ncc"]["median"].get<double>(), 0.8);
+  EXPECT_GT(j["psnr_db"]["median"].get<double>(), 18.0);
+  EXPECT_EQ(j["frames"][0]["frame"].get<int>(), 30);
+
+  // No ground truth: the dataset is named, exit 1.
+  const fs::path blind = CopyData("data_no_gt");
+  fs::remove(blind / "groundtruth.txt");
+  r = RunMonomap("eval render " + map.string() + " " + blind.string());
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("groundtruth.txt"), std::string::npos) << r.output;
+  EXPECT_EQ(RunMonomap("eval render " + map.string() + " " + data.string() +
+                       " --stride 0")
                 .exit_code,
             2);
 }

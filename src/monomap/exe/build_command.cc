@@ -55,7 +55,7 @@ void RegisterBuildCommand(CLI::App& app) {
   cmd->add_option("--affine-interval", args->affine_interval,
                   "Align each feature with its reference patch every n-th "
                   "frame (corrections in between interpolated)")
-      ->check(CLI::PositiveNumber);
+      ->check(CLI::Range(1, 1000000));
   cmd->add_flag("-q,--quiet", args->quiet, "No progress output");
   cmd->add_flag("--ba-verbose", args->ba_verbose,
                 "Print the bundle adjustment solver's progress and report");

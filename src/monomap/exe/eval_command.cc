@@ -3,6 +3,8 @@
 // monomap eval checkerboard MAP_DIR --structure STRUCTURE.yaml
 // monomap eval structure MAP_DIR --structure STRUCTURE_DIR
 //     [--align none|first-pose --groundtruth GT.txt]
+// monomap eval render MAP_DIR DATASET [--stride N] [--width W]
+//     [--first-frame F --frames N] [--align none|first-pose]
 // monomap eval trajectory ESTIMATE.txt GROUNDTRUTH.txt [--align ...]
 #include <cstdio>
 #include <filesystem>
@@ -11,10 +13,12 @@
 
 #include "monomap/eval/checkerboard_accuracy.h"
 #include "monomap/eval/point_accuracy.h"
+#include "monomap/eval/render_fidelity.h"
 #include "monomap/eval/report_json.h"
 #include "monomap/eval/structure_accuracy.h"
 #include "monomap/eval/trajectory_metrics.h"
 #include "monomap/exe/commands.h"
+#include "monomap/io/dataset.h"
 #include "monomap/io/feature_table.h"
 #include "monomap/io/map_format.h"
 #include "monomap/io/ply.h"
@@ -31,8 +35,7 @@ namespace {
 std::vector<double> DistanceToTrajectory(
     const std::vector<Eigen::Vector3d>& points,
     const std::vector<TimedPose>& trajectory) {
-  std::vector<double> d(points.size(),
-                        std::numeric_limits<double>::infinity());
+  std::vector<double> d(points.size(), std::numeric_limits<double>::infinity());
   for (size_t i = 0; i < points.size(); ++i) {
     for (const auto& p : trajectory) {
       d[i] = std::min(d[i], (points[i] - p.world_from_cam.translation).norm());
@@ -62,8 +65,8 @@ void RegisterEvalCommand(CLI::App& app) {
   CLI::App* points = eval->add_subcommand(
       "points", "Point error against a ground-truth plane or surface cloud");
   points->add_option("map", pa->map_dir, "Map directory")->required();
-  auto* plane_opt = points->add_option(
-      "--plane", pa->plane_yaml, "Ground-truth structure YAML (plane)");
+  auto* plane_opt = points->add_option("--plane", pa->plane_yaml,
+                                       "Ground-truth structure YAML (plane)");
   auto* surface_opt = points->add_option("--surface", pa->surface_ply,
                                          "Ground-truth surface PLY");
   plane_opt->excludes(surface_opt);
@@ -74,8 +77,9 @@ void RegisterEvalCommand(CLI::App& app) {
   points->add_option("--json", pa->json, "Write the figures as JSON");
   points->callback([pa]() {
     if (pa->plane_yaml.empty() == pa->surface_ply.empty()) {
-      throw OptionsError("eval points: give exactly one of --plane or "
-                         "--surface");
+      throw OptionsError(
+          "eval points: give exactly one of --plane or "
+          "--surface");
     }
     const Map map = ReadMap(pa->map_dir);
     int label = pa->plane_label;
@@ -87,10 +91,10 @@ void RegisterEvalCommand(CLI::App& app) {
       if (counts.empty()) {
         throw StageError(pa->map_dir + ": map has no plane labels");
       }
-      label = std::max_element(counts.begin(), counts.end(),
-                               [](auto& a, auto& b) {
-                                 return a.second < b.second;
-                               })->first;
+      label =
+          std::max_element(counts.begin(), counts.end(), [](auto& a, auto& b) {
+            return a.second < b.second;
+          })->first;
     }
     std::vector<Eigen::Vector3d> xs;
     for (const auto& l : map.landmarks) {
@@ -100,8 +104,8 @@ void RegisterEvalCommand(CLI::App& app) {
     const auto dist = DistanceToTrajectory(xs, map.trajectory);
     PointAccuracy acc;
     if (!pa->plane_yaml.empty()) {
-      acc = EvaluatePointsAgainstPlane(xs, dist,
-                                       ReadGroundTruthPlaneYaml(pa->plane_yaml));
+      acc = EvaluatePointsAgainstPlane(
+          xs, dist, ReadGroundTruthPlaneYaml(pa->plane_yaml));
     } else {
       const NearestNeighborIndex index(ReadPlyPoints(pa->surface_ply));
       acc = EvaluatePointsAgainstCloud(xs, dist, index);
@@ -130,8 +134,9 @@ void RegisterEvalCommand(CLI::App& app) {
   planes->add_option("--json", pl->json, "Write the figures as JSON");
   planes->callback([pl]() {
     if (pl->plane_yaml.empty() == pl->surface_ply.empty()) {
-      throw OptionsError("eval planes: give exactly one of --plane or "
-                         "--surface");
+      throw OptionsError(
+          "eval planes: give exactly one of --plane or "
+          "--surface");
     }
     const Map map = ReadMap(pl->map_dir);
     std::unique_ptr<NearestNeighborIndex> index;
@@ -189,8 +194,9 @@ void RegisterEvalCommand(CLI::App& app) {
       "Find a known checkerboard in the plane textures and compare its "
       "corners, mapped to 3D, with their true positions");
   board->add_option("map", ba->map_dir, "Map directory")->required();
-  board->add_option("--structure", ba->structure,
-                    "Ground-truth structure YAML with a 'chessboard' entry")
+  board
+      ->add_option("--structure", ba->structure,
+                   "Ground-truth structure YAML with a 'chessboard' entry")
       ->required();
   board->add_option("--json", ba->json, "Write the figures as JSON");
   board->callback([ba]() {
@@ -245,12 +251,14 @@ void RegisterEvalCommand(CLI::App& app) {
   structure->callback([sa]() {
     const bool first_pose = sa->align == "first-pose";
     if (first_pose && sa->groundtruth.empty()) {
-      throw OptionsError("eval structure: --align first-pose needs "
-                         "--groundtruth");
+      throw OptionsError(
+          "eval structure: --align first-pose needs "
+          "--groundtruth");
     }
     if (!first_pose && !sa->groundtruth.empty()) {
-      throw OptionsError("eval structure: --groundtruth is only used with "
-                         "--align first-pose");
+      throw OptionsError(
+          "eval structure: --groundtruth is only used with "
+          "--align first-pose");
     }
     Map map = ReadMap(sa->map_dir);
     const Map truth = ReadMap(sa->structure_dir);
@@ -265,14 +273,13 @@ void RegisterEvalCommand(CLI::App& app) {
                    "the distance to the nearest camera\n",
                    features.string().c_str());
     }
-    SetLandmarkDepths(have_features ? ReadFeatureTable(features)
-                                    : std::vector<Track>(),
-                      &map);
+    SetLandmarkDepths(
+        have_features ? ReadFeatureTable(features) : std::vector<Track>(),
+        &map);
     Rigid3d truth_from_map;
     if (first_pose) {
       truth_from_map =
-          AlignTrajectories(map.trajectory,
-                            ReadTumTrajectory(sa->groundtruth),
+          AlignTrajectories(map.trajectory, ReadTumTrajectory(sa->groundtruth),
                             Alignment::kFirstPose)
               .rigid;
     }
@@ -280,19 +287,99 @@ void RegisterEvalCommand(CLI::App& app) {
         EvaluateStructure(map, truth, truth_from_map, sa->options);
     nlohmann::json j = ToJson(acc);
     j["alignment"] = sa->align;
-    j["relative_error_depth"] =
-        have_features ? "mean_distance_to_observing_cameras"
-                      : "distance_to_nearest_camera";
+    j["relative_error_depth"] = have_features
+                                    ? "mean_distance_to_observing_cameras"
+                                    : "distance_to_nearest_camera";
     j["options"] = {
         {"max_match_angle_deg", sa->options.max_match_angle_deg},
         {"max_match_offset_m", sa->options.max_match_offset_m},
         {"polygon_margin_m", sa->options.polygon_margin_m},
         {"min_observed_landmarks", sa->options.min_observed_landmarks},
         {"observed_distance_m", sa->options.observed_distance_m}};
-    PrintOrWrite(j,
-                 "structure accuracy (alignment " + sa->align + ")\n" +
-                     FormatTable(acc),
-                 sa->json);
+    PrintOrWrite(
+        j,
+        "structure accuracy (alignment " + sa->align + ")\n" + FormatTable(acc),
+        sa->json);
+  });
+
+  struct RenderArgs {
+    std::string map_dir, dataset, align = "none", json;
+    int stride = 5, first_frame = 0, num_frames = -1;
+    RenderFidelityOptions options;
+  };
+  auto ra = std::make_shared<RenderArgs>();
+  CLI::App* render = eval->add_subcommand(
+      "render",
+      "Texture fidelity: render the map from a dataset's ground-truth poses "
+      "and compare with its images (NCC, gain-compensated PSNR)");
+  render->add_option("map", ra->map_dir, "Map directory")->required();
+  render
+      ->add_option("dataset", ra->dataset,
+                   "Dataset with groundtruth.txt (best: frames the map was "
+                   "not built from)")
+      ->required();
+  render->add_option("--stride", ra->stride, "Compare every n-th frame")
+      ->check(CLI::Range(1, 1000000))
+      ->capture_default_str();
+  render
+      ->add_option("--width", ra->options.width,
+                   "Compare at this width (0: the camera's)")
+      ->capture_default_str();
+  render
+      ->add_option("--min-coverage", ra->options.min_coverage,
+                   "Skip frames whose render covers less of the image")
+      ->capture_default_str();
+  render->add_option("--first-frame", ra->first_frame, "First dataset frame");
+  render->add_option("--frames", ra->num_frames, "Number of frames");
+  render
+      ->add_option("--align", ra->align,
+                   "none: the map is in the ground truth's frame; "
+                   "first-pose: align the map's first trajectory pose with "
+                   "the dataset's ground truth at that time (same run)")
+      ->check(CLI::IsMember({"none", "first-pose"}))
+      ->capture_default_str();
+  render->add_option("--json", ra->json, "Write the figures as JSON");
+  render->callback([ra]() {
+    const Map map = ReadMap(ra->map_dir);
+    DatasetOptions dataset_options;
+    dataset_options.first_frame = ra->first_frame;
+    dataset_options.num_frames = ra->num_frames;
+    // Alignment needs the ground truth at the map's first pose, which may
+    // lie before --first-frame: load it from the whole dataset.
+    const Dataset dataset = LoadDataset(ra->dataset, dataset_options);
+    if (!dataset.has_groundtruth) {
+      throw InputError(ra->dataset +
+                       ": no groundtruth.txt: eval render "
+                       "renders from ground-truth poses");
+    }
+    Rigid3d map_from_truth;
+    if (ra->align == "first-pose") {
+      std::vector<TimedPose> truth;
+      for (const DatasetFrame& f : LoadDataset(ra->dataset).frames) {
+        truth.push_back({f.timestamp, *f.groundtruth_world_from_cam});
+      }
+      map_from_truth =
+          AlignTrajectories(truth, map.trajectory, Alignment::kFirstPose).rigid;
+    }
+    std::vector<Rigid3d> poses;
+    std::vector<cv::Mat> images;
+    std::vector<int> frames;
+    for (size_t i = 0; i < dataset.frames.size();
+         i += static_cast<size_t>(ra->stride)) {
+      poses.push_back(map_from_truth *
+                      *dataset.frames[i].groundtruth_world_from_cam);
+      images.push_back(dataset.LoadImage(i));
+      frames.push_back(ra->first_frame + static_cast<int>(i));
+    }
+    const RenderFidelity f = EvaluateRenderFidelity(
+        map, dataset.camera, poses, images, frames, ra->options);
+    nlohmann::json j = ToJson(f);
+    j["alignment"] = ra->align;
+    j["stride"] = ra->stride;
+    j["width"] = ra->options.width;
+    PrintOrWrite(
+        j, "texture fidelity (alignment " + ra->align + ")\n" + FormatTable(f),
+        ra->json);
   });
 
   struct TrajArgs {
@@ -314,11 +401,10 @@ void RegisterEvalCommand(CLI::App& app) {
   traj->callback([ta]() {
     const auto est = ReadTumTrajectory(ta->estimate);
     const auto gt = ReadTumTrajectory(ta->groundtruth);
-    const Alignment alignment =
-        ta->align == "none"    ? Alignment::kNone
-        : ta->align == "first" ? Alignment::kFirstPose
-        : ta->align == "se3"   ? Alignment::kSE3
-                               : Alignment::kSim3;
+    const Alignment alignment = ta->align == "none"    ? Alignment::kNone
+                                : ta->align == "first" ? Alignment::kFirstPose
+                                : ta->align == "se3"   ? Alignment::kSE3
+                                                       : Alignment::kSim3;
     const TrajectoryErrors ate =
         AbsoluteTrajectoryError(est, gt, alignment, 1e-3);
     const TrajectoryErrors rpe = RelativePoseError(est, gt, ta->delta, 1e-3);
