@@ -229,6 +229,8 @@ void BundleAdjustmentOptions::Check() const {
   CheckOption(max_num_iterations >= 0, "max_num_iterations", "must be >= 0");
   CheckOption(function_tolerance > 0, "function_tolerance", "must be positive");
   CheckOption(num_threads >= 1, "num_threads", "must be >= 1");
+  CheckOption(dense_schur_max_poses >= 0, "dense_schur_max_poses",
+              "must be >= 0");
   CheckOption(max_reprojection_error_px > 0, "max_reprojection_error_px",
               "must be positive");
   CheckOption(min_depth_m > 0, "min_depth_m", "must be positive");
