@@ -144,113 +144,94 @@ void KltTracker::Track(int frame_index, const cv::Mat& grey,
     ParallelPyrLk(prev_pyramid_, pyramid, prev_pts, &next_pts, &status, &error,
                   options_);
 
-    // Candidates: the features that survived the forward track, moved to
-    // where it put them (their previous position kept for the check).
-    std::vector<Active> cand;
-    std::vector<cv::Point2f> prev_of, fwd_of;
-    cand.reserve(active_.size());
+    // Backward only for the features that survived the forward track.
+    std::vector<size_t> forward_ok;
+    std::vector<cv::Point2f> fwd_pts;
     for (size_t i = 0; i < active_.size(); ++i) {
       if (!status[i]) {
         ++stats.lost_lk;
       } else if (options_.max_lk_error > 0.0 &&
                  error[i] > options_.max_lk_error) {
         ++stats.lost_error;
-      } else if (!std::isfinite(next_pts[i].x) ||
-                 !std::isfinite(next_pts[i].y)) {
-        ++stats.lost_lk;
       } else {
-        prev_of.push_back(active_[i].px);
-        fwd_of.push_back(next_pts[i]);
-        cand.push_back(std::move(active_[i]));
-        cand.back().px = next_pts[i];
+        forward_ok.push_back(i);
+        fwd_pts.push_back(next_pts[i]);
       }
-    }
-
-    // Alignment with each feature's reference patch (on its interval
-    // frames): corrects the frame-to-frame drift.
-    std::vector<char> refined(cand.size(), 0), reanchored(cand.size(), 0);
-    if (options_.affine_refinement) {
-      const int interval = options_.affine_interval;
-      tbb::parallel_for(tbb::blocked_range<size_t>(0, cand.size(), 32),
-                        [&](const tbb::blocked_range<size_t>& r) {
-                          for (size_t i = r.begin(); i != r.end(); ++i) {
-                            Active& f = cand[i];
-                            if ((frame_index + f.id) % interval != 0) continue;
-                            bool ref = false, re = false;
-                            RefineFeature(grey, &f, &ref, &re);
-                            refined[i] = ref;
-                            reanchored[i] = re;
-                          }
-                        });
-    }
-
-    // Forward-backward check for the features the alignment did not
-    // confirm: an accepted alignment already matched the feature's own
-    // reference appearance, a stronger test than tracking back one frame.
-    std::vector<size_t> to_check;
-    std::vector<cv::Point2f> check_pts;
-    for (size_t i = 0; i < cand.size(); ++i) {
-      if (refined[i] && options_.skip_backward_when_aligned) continue;
-      to_check.push_back(i);
-      check_pts.push_back(fwd_of[i]);  // where LK put it, as tracked
     }
     std::vector<cv::Point2f> back_pts;
     std::vector<uchar> back_status;
     std::vector<float> back_error;
-    if (!check_pts.empty()) {
+    if (!fwd_pts.empty()) {
       // No initial guess at the original position: starting there would
       // pull the backward track home even from content that changed.
-      ParallelPyrLk(pyramid, prev_pyramid_, check_pts, &back_pts, &back_status,
+      ParallelPyrLk(pyramid, prev_pyramid_, fwd_pts, &back_pts, &back_status,
                     &back_error, options_);
-    }
-    std::vector<char> drop(cand.size(), 0);
-    const double fb2 = options_.forward_backward_threshold_px *
-                       options_.forward_backward_threshold_px;
-    for (size_t k = 0; k < to_check.size(); ++k) {
-      const size_t i = to_check[k];
-      if (!back_status[k]) {
-        ++stats.lost_lk;
-        drop[i] = 1;
-        continue;
-      }
-      const cv::Point2f d = back_pts[k] - prev_of[i];
-      if (static_cast<double>(d.dot(d)) > fb2) {
-        ++stats.lost_forward_backward;
-        drop[i] = 1;
-      }
     }
 
     const double margin = options_.border_margin_px;
     const double max_x = size_.width - 1 - margin;
     const double max_y = size_.height - 1 - margin;
+    const double fb2 = options_.forward_backward_threshold_px *
+                       options_.forward_backward_threshold_px;
     std::vector<Active> kept;
-    kept.reserve(cand.size());
-    for (size_t i = 0; i < cand.size(); ++i) {
-      if (drop[i]) continue;
-      Active& f = cand[i];
-      const cv::Point2f p = f.px;
+    kept.reserve(active_.size());
+    for (size_t k = 0; k < forward_ok.size(); ++k) {
+      Active& a = active_[forward_ok[k]];
+      const cv::Point2f p = fwd_pts[k];
+      if (!back_status[k]) {
+        ++stats.lost_lk;
+        continue;
+      }
+      const cv::Point2f d = back_pts[k] - a.px;
+      if (static_cast<double>(d.dot(d)) > fb2 || !std::isfinite(p.x) ||
+          !std::isfinite(p.y)) {
+        ++stats.lost_forward_backward;
+        continue;
+      }
       if (p.x < margin || p.y < margin || p.x > max_x || p.y > max_y) {
         ++stats.lost_border;
         continue;
       }
-      stats.refined += refined[i];
-      stats.reanchored += reanchored[i];
-      if (refined[i]) {
-        // The frames since the last alignment drifted by a growing share
-        // of this correction (refined position minus forward LK's).
-        const cv::Point2f correction = p - fwd_of[i];
-        const double span = frame_index - f.reference_frame;
-        auto& obs = tracks_[static_cast<size_t>(f.id)].observations;
-        for (auto o = obs.rbegin();
-             o != obs.rend() && o->frame > f.reference_frame; ++o) {
-          const double share = (o->frame - f.reference_frame) / span;
-          o->px += share * Eigen::Vector2d(correction.x, correction.y);
-        }
-      }
-      if (refined[i] || reanchored[i]) f.reference_frame = frame_index;
-      kept.push_back(std::move(f));
+      a.px = p;
+      kept.push_back(std::move(a));
     }
     active_ = std::move(kept);
+    if (options_.affine_refinement) {
+      const int interval = options_.affine_interval;
+      std::vector<char> refined(active_.size(), 0),
+          reanchored(active_.size(), 0);
+      std::vector<cv::Point2f> correction(active_.size());
+      tbb::parallel_for(tbb::blocked_range<size_t>(0, active_.size(), 32),
+                        [&](const tbb::blocked_range<size_t>& r) {
+                          for (size_t i = r.begin(); i != r.end(); ++i) {
+                            Active& f = active_[i];
+                            if ((frame_index + f.id) % interval != 0) continue;
+                            const cv::Point2f before = f.px;
+                            bool ref = false, re = false;
+                            RefineFeature(grey, &f, &ref, &re);
+                            refined[i] = ref;
+                            reanchored[i] = re;
+                            correction[i] = f.px - before;
+                          }
+                        });
+      for (size_t i = 0; i < active_.size(); ++i) {
+        stats.refined += refined[i];
+        stats.reanchored += reanchored[i];
+        Active& f = active_[i];
+        if (refined[i]) {
+          // The frames since the last alignment drifted by a growing share
+          // of this correction.
+          const double span = frame_index - f.reference_frame;
+          auto& obs = tracks_[static_cast<size_t>(f.id)].observations;
+          for (auto o = obs.rbegin();
+               o != obs.rend() && o->frame > f.reference_frame; ++o) {
+            const double share = (o->frame - f.reference_frame) / span;
+            o->px += share * Eigen::Vector2d(correction[i].x, correction[i].y);
+          }
+        }
+        if (refined[i] || reanchored[i]) f.reference_frame = frame_index;
+      }
+    }
     for (const Active& a : active_) {
       tracks_[static_cast<size_t>(a.id)].observations.push_back(
           {frame_index, Eigen::Vector2d(a.px.x, a.px.y)});

@@ -69,10 +69,6 @@ struct KltTrackerOptions {
   bool affine_refinement = true;
   // Options of that alignment.
   AffineRefinementOptions affine;
-  // Skip the forward-backward check for features whose alignment with
-  // their reference patch was accepted in this frame (it already confirms
-  // them, against their own appearance): saves most backward tracks.
-  bool skip_backward_when_aligned = true;
   // A feature is aligned every n-th frame (staggered over the features, so
   // every frame does 1/n of them); the frames in between get the
   // correction interpolated, since drift grows smoothly. 1: every frame.
