@@ -1,5 +1,6 @@
 // monomap localize MAP_DIR DATASET --method mcl|mcc [--particles N]
 //   [--init global|pose] [--state planar|6dof] -o TRAJ.txt [--report R.json]
+#include <algorithm>
 #include <cstdio>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -37,7 +38,9 @@ void RegisterLocalizeCommand(CLI::App& app) {
       ->check(CLI::IsMember({"global", "pose"}));
   cmd->add_option("--state", a->state, "planar | 6dof")
       ->check(CLI::IsMember({"planar", "6dof"}));
-  cmd->add_option("--particles", a->particles, "Particle budget");
+  cmd->add_option("--particles", a->particles,
+                  "Particle budget (initial count and KLD maximum)")
+      ->check(CLI::Range(10, 1000000));
   cmd->add_option("--mcc-size", a->mcc_size,
                   "WxH of the renders MCC tracks against (default 160x120)");
   cmd->add_option("--mcc-top-k", a->mcc_top_k,
@@ -60,7 +63,11 @@ void RegisterLocalizeCommand(CLI::App& app) {
     options.method = ParseLocalizationMethod(a->method);
     options.init = ParseLocalizationInit(a->init);
     options.state = ParseLocalizationState(a->state);
+    // The budget: the initial count and KLD-sampling's maximum.
     options.num_particles = a->particles;
+    options.kld.max_particles = a->particles;
+    options.kld.min_particles =
+        std::min(options.kld.min_particles, a->particles);
     if (!a->mcc_size.empty()) {
       ParseImageSize(a->mcc_size, "--mcc-size", &options.mcc.width,
                      &options.mcc.height);
@@ -73,9 +80,9 @@ void RegisterLocalizeCommand(CLI::App& app) {
     options.seed = a->seed;
     std::vector<TimedPose> trajectory;
     std::vector<std::vector<Particle>> sets;
-    const LocalizationReport r = LocalizeSequence(
-        map, dataset, options, &trajectory,
-        a->particles_out.empty() ? nullptr : &sets);
+    const LocalizationReport r =
+        LocalizeSequence(map, dataset, options, &trajectory,
+                         a->particles_out.empty() ? nullptr : &sets);
     WriteTumTrajectory(a->output, trajectory,
                        "monomap localize --method " + a->method);
     if (!a->particles_out.empty()) {
