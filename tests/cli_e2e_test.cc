@@ -218,5 +218,50 @@ TEST_F(Cli, EvalRenderComparesHeldOutFrames) {
             2);
 }
 
+// Localization end to end through the binary: a map of the 40 frames,
+// the same frames localized from their first true pose (planar MCC), the
+// trajectory, report and particle sets written, errors in centimetres.
+TEST_F(Cli, LocalizeTracksTheDatasetInItsMap) {
+  const fs::path data = *root_ / "data";
+  const fs::path map = *root_ / "map_localize";
+  RunResult r =
+      RunMonomap("build " + data.string() + " -o " + map.string() + " -q");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const fs::path traj = *root_ / "localized.txt";
+  const fs::path report = *root_ / "localize.json";
+  const fs::path particles = *root_ / "particles.csv";
+  r = RunMonomap("localize " + map.string() + " " + data.string() +
+                 " --method mcc --init pose --particles 200 -o " +
+                 traj.string() + " --report " + report.string() +
+                 " --particles-out " + particles.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::ifstream in(report);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_EQ(j["frames"].get<int>(), 40);
+  // Measured 5 mm rms, 8 mm at the end.
+  EXPECT_LT(j["rmse_translation_m"].get<double>(), 0.02);
+  EXPECT_LT(j["final_translation_error_m"].get<double>(), 0.03);
+  // The budget caps KLD-sampling: never more than 200 particles.
+  for (const auto& step : j["steps"]) {
+    EXPECT_LE(step["particles"].get<int>(), 200);
+  }
+  r = RunMonomap("eval trajectory " + traj.string() + " " +
+                 (data / "groundtruth.txt").string() + " --align none");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("matched 40"), std::string::npos) << r.output;
+  EXPECT_TRUE(fs::exists(particles));
+
+  // A missing map is named (exit 1); a budget below 10 is a usage error.
+  r = RunMonomap("localize /nonexistent/map " + data.string() + " -o " +
+                 (*root_ / "x.txt").string());
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("/nonexistent/map"), std::string::npos) << r.output;
+  EXPECT_EQ(RunMonomap("localize " + map.string() + " " + data.string() +
+                       " --particles 5 -o " + (*root_ / "x.txt").string())
+                .exit_code,
+            2);
+  EXPECT_FALSE(fs::exists(*root_ / "x.txt"));
+}
+
 }  // namespace
 }  // namespace monomap
