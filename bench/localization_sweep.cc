@@ -38,6 +38,7 @@
 #include "monomap/util/file.h"
 #include "monomap/util/progress.h"
 #include "monomap/util/runtime.h"
+#include "sweep_main.h"
 
 namespace monomap {
 namespace {
@@ -192,9 +193,11 @@ nlohmann::json RunSeed(const SweepOptions& o, const std::string& world,
 
   // 3. Every configuration from a global initialisation.
   nlohmann::json results = nlohmann::json::object();
-  std::fprintf(stderr, "%s seed %d: map %zu landmarks, %zu planes, error "
-               "median %.1f cm;", world.c_str(), seed, map.landmarks.size(),
-               map.planes.size(), 100 * map_ate.translation_m.median);
+  std::fprintf(stderr,
+               "%s seed %d: map %zu landmarks, %zu planes, error "
+               "median %.1f cm;",
+               world.c_str(), seed, map.landmarks.size(), map.planes.size(),
+               100 * map_ate.translation_m.median);
   for (size_t c = 0; c < configs.size(); ++c) {
     LocalizerOptions lo;
     lo.method = configs[c].method;
@@ -260,13 +263,13 @@ nlohmann::json RunSeed(const SweepOptions& o, const std::string& world,
         {"ms_per_step", steps_ms},
         {"best_ncc_per_step", steps_ncc},
         {"cluster_weight_per_step", steps_cluster}};
-    std::fprintf(stderr, " %s %s (%s, %.1f cm)", configs[c].name.c_str(),
-                 run.accuracy.success ? "ok" : "FAIL",
-                 run.accuracy.converged_step >= 0
-                     ? ("step " + std::to_string(run.accuracy.converged_step))
-                           .c_str()
-                     : "-",
-                 100 * run.accuracy.final_translation_error_m);
+    std::fprintf(
+        stderr, " %s %s (%s, %.1f cm)", configs[c].name.c_str(),
+        run.accuracy.success ? "ok" : "FAIL",
+        run.accuracy.converged_step >= 0
+            ? ("step " + std::to_string(run.accuracy.converged_step)).c_str()
+            : "-",
+        100 * run.accuracy.final_translation_error_m);
   }
   std::fprintf(stderr, "\n");
   if (!keep) fs::remove_all(loc_data);
@@ -281,13 +284,15 @@ nlohmann::json Summarize(const SweepOptions& o, const std::string& world,
                          const std::vector<Config>& configs,
                          const std::vector<std::vector<ConfigRun>>& runs) {
   nlohmann::json summary = nlohmann::json::object();
-  std::printf("\n### %s: %d seeds (%d..%d), map %d frames, localization %d "
-              "frames, %dx%d\n\n",
-              world.c_str(), o.seeds, o.first_seed, o.first_seed + o.seeds - 1,
-              o.map_frames, o.loc_frames, o.width, o.height);
-  std::printf("| method | particles | success | median converged step | "
-              "median final error | median mean tracking error (converged "
-              "runs) | mean particles | mean ms / update |\n");
+  std::printf(
+      "\n### %s: %d seeds (%d..%d), map %d frames, localization %d "
+      "frames, %dx%d\n\n",
+      world.c_str(), o.seeds, o.first_seed, o.first_seed + o.seeds - 1,
+      o.map_frames, o.loc_frames, o.width, o.height);
+  std::printf(
+      "| method | particles | success | median converged step | "
+      "median final error | median mean tracking error (converged "
+      "runs) | mean particles | mean ms / update |\n");
   std::printf("|---|---|---|---|---|---|---|---|\n");
   std::vector<std::string> over_time;
   for (size_t c = 0; c < configs.size(); ++c) {
@@ -319,8 +324,7 @@ nlohmann::json Summarize(const SweepOptions& o, const std::string& world,
     }
     const int n = static_cast<int>(runs.size());
     nlohmann::json s;
-    s["method"] = configs[c].method == LocalizationMethod::kMcc ? "mcc"
-                                                                : "mcl";
+    s["method"] = configs[c].method == LocalizationMethod::kMcc ? "mcc" : "mcl";
     s["particles_budget"] = configs[c].particles;
     s["runs"] = n;
     s["runs_finished"] = ok;
@@ -344,19 +348,20 @@ nlohmann::json Summarize(const SweepOptions& o, const std::string& world,
     s["mean_particles_at_step"] = pt;
     over_time.push_back(row);
     summary[configs[c].name] = s;
-    std::printf("| %s | %d | %d/%d | %s | %s cm / %s deg | %s cm / %s deg | "
-                "%s | %s |\n",
-                s["method"].get<std::string>().c_str(), configs[c].particles,
-                success, n, Fmt("%.0f", Median(conv)).c_str(),
-                Fmt("%.1f", 100 * Median(final_t)).c_str(),
-                Fmt("%.1f", Median(final_r)).c_str(),
-                Fmt("%.1f", 100 * Median(mean_t)).c_str(),
-                Fmt("%.2f", Median(mean_r)).c_str(),
-                Fmt("%.0f", Mean(particles)).c_str(),
-                Fmt("%.1f", Mean(ms)).c_str());
+    std::printf(
+        "| %s | %d | %d/%d | %s | %s cm / %s deg | %s cm / %s deg | "
+        "%s | %s |\n",
+        s["method"].get<std::string>().c_str(), configs[c].particles, success,
+        n, Fmt("%.0f", Median(conv)).c_str(),
+        Fmt("%.1f", 100 * Median(final_t)).c_str(),
+        Fmt("%.1f", Median(final_r)).c_str(),
+        Fmt("%.1f", 100 * Median(mean_t)).c_str(),
+        Fmt("%.2f", Median(mean_r)).c_str(),
+        Fmt("%.0f", Mean(particles)).c_str(), Fmt("%.1f", Mean(ms)).c_str());
   }
-  std::printf("\nParticles alive (mean over seeds) after step:\n\n| "
-              "configuration |");
+  std::printf(
+      "\nParticles alive (mean over seeds) after step:\n\n| "
+      "configuration |");
   for (int k : kParticleSteps) std::printf(" %d |", k);
   std::printf("\n|---|");
   for (size_t k = 0; k < kParticleSteps.size(); ++k) std::printf("---|");
@@ -387,25 +392,24 @@ int Run(const SweepOptions& o) {
   fs::create_directories(root);
 
   nlohmann::json out;
-  out["options"] = {{"worlds", o.worlds},
-                    {"seeds", o.seeds},
-                    {"first_seed", o.first_seed},
-                    {"map_frames", o.map_frames},
-                    {"loc_frames", o.loc_frames},
-                    {"width", o.width},
-                    {"height", o.height},
-                    {"particles", o.particles},
-                    {"kld", !o.fixed_count},
-                    {"start_offset_m", o.start_offset_m},
-                    {"lateral_offset_m", o.lateral_offset_m},
-                    {"run_seed_base", o.run_seed_base},
-                    {"ba_threads", o.ba_threads},
-                    {"max_translation_error_m",
-                     o.accuracy.max_translation_error_m},
-                    {"max_rotation_error_deg",
-                     o.accuracy.max_rotation_error_deg},
-                    {"state", "planar"},
-                    {"init", "global"}};
+  out["options"] = {
+      {"worlds", o.worlds},
+      {"seeds", o.seeds},
+      {"first_seed", o.first_seed},
+      {"map_frames", o.map_frames},
+      {"loc_frames", o.loc_frames},
+      {"width", o.width},
+      {"height", o.height},
+      {"particles", o.particles},
+      {"kld", !o.fixed_count},
+      {"start_offset_m", o.start_offset_m},
+      {"lateral_offset_m", o.lateral_offset_m},
+      {"run_seed_base", o.run_seed_base},
+      {"ba_threads", o.ba_threads},
+      {"max_translation_error_m", o.accuracy.max_translation_error_m},
+      {"max_rotation_error_deg", o.accuracy.max_rotation_error_deg},
+      {"state", "planar"},
+      {"init", "global"}};
   out["runs"] = nlohmann::json::array();
   out["summary"] = nlohmann::json::object();
   const Timer total;
@@ -443,8 +447,9 @@ int Run(const SweepOptions& o) {
 int main(int argc, char** argv) {
   monomap::ConfigureRuntime();
   monomap::SweepOptions o;
-  CLI::App app{"Global localization sweep: MCL vs MCC over seeds on "
-               "simulated worlds"};
+  CLI::App app{
+      "Global localization sweep: MCL vs MCC over seeds on "
+      "simulated worlds"};
   app.add_option("--worlds", o.worlds, "Worlds (comma-separated)")
       ->delimiter(',');
   app.add_option("--seeds", o.seeds, "Number of seeds per world");
@@ -472,18 +477,6 @@ int main(int argc, char** argv) {
   app.add_option("--keep-dir", o.keep_dir,
                  "Write datasets and maps here and keep them (default: a "
                  "temporary directory, emptied as the sweep goes)");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? 0 : 2;
-  }
-  try {
-    return monomap::Run(o);
-  } catch (const monomap::OptionsError& e) {
-    std::fprintf(stderr, "localization_sweep: error: %s\n", e.what());
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "localization_sweep: error: %s\n", e.what());
-    return 3;
-  }
+  return monomap::ParseAndRunSweep(app, argc, argv, "localization_sweep",
+                                   [&] { return monomap::Run(o); });
 }

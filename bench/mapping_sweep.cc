@@ -37,6 +37,7 @@
 #include "monomap/util/file.h"
 #include "monomap/util/progress.h"
 #include "monomap/util/runtime.h"
+#include "sweep_main.h"
 
 namespace monomap {
 namespace {
@@ -217,18 +218,6 @@ int main(int argc, char** argv) {
   app.add_option("--noise-frames", o.noise_frames,
                  "Sequence length of the odometry sweep");
   app.add_option("--out", o.out, "JSON output file");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? 0 : 2;
-  }
-  try {
-    return monomap::Run(o);
-  } catch (const monomap::OptionsError& e) {
-    std::fprintf(stderr, "mapping_sweep: error: %s\n", e.what());
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "mapping_sweep: error: %s\n", e.what());
-    return 3;
-  }
+  return monomap::ParseAndRunSweep(app, argc, argv, "mapping_sweep",
+                                   [&] { return monomap::Run(o); });
 }
