@@ -27,22 +27,6 @@ namespace {
 
 constexpr double kRadToDeg = 180.0 / M_PI;
 
-// Distance from p to the boundary of a polygon (0 for < 2 vertices).
-double DistanceToPolygonBoundary(const Polygon2d& polygon,
-                                 const Eigen::Vector2d& p) {
-  double best = std::numeric_limits<double>::infinity();
-  for (size_t i = 0; i < polygon.size(); ++i) {
-    const Eigen::Vector2d& a = polygon[i];
-    const Eigen::Vector2d& b = polygon[(i + 1) % polygon.size()];
-    const Eigen::Vector2d ab = b - a;
-    const double len2 = ab.squaredNorm();
-    const double t =
-        len2 > 0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
-    best = std::min(best, (a + t * ab - p).norm());
-  }
-  return polygon.size() < 2 ? 0.0 : best;
-}
-
 // A landmark's nearest true plane among those containing its projection.
 struct Assignment {
   int true_index = -1;
@@ -58,9 +42,9 @@ Assignment AssignToTruth(const std::vector<TexturedPlane>& truth,
     const double d = std::abs(p.plane.SignedDistance(x));
     if (d >= best.distance_m) continue;
     const Eigen::Vector2d st = p.frame.ToPlane(x);
+    // A polygon of fewer than 3 vertices bounds nothing: the whole plane.
     const bool inside = p.polygon.size() < 3 ||
-                        PointInPolygon(p.polygon, st) ||
-                        DistanceToPolygonBoundary(p.polygon, st) <= margin_m;
+                        DistanceToPolygon(p.polygon, st) <= margin_m;
     if (inside) best = {static_cast<int>(j), d};
   }
   if (best.true_index < 0) best.distance_m = 0.0;
