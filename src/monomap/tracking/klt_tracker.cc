@@ -361,10 +361,11 @@ void KltTracker::RefineFeature(const cv::Mat& grey, Active* f, bool* refined,
   if (keep_reference) return;
   // A new reference where the feature is now (frame-to-frame position if
   // the alignment failed).
-  *reanchored = true;
+  // Counted only if a patch was taken: an edge-like or flat one is refused
+  // (and tried again next frame), which leaves the feature plain LK.
   f->warp.setIdentity();
-  f->reference.Extract(grey, Eigen::Vector2f(f->px.x, f->px.y),
-                       options_.affine);
+  *reanchored = f->reference.Extract(grey, Eigen::Vector2f(f->px.x, f->px.y),
+                                     options_.affine);
 }
 
 std::vector<KltFeature> KltTracker::Features() const {
