@@ -22,6 +22,7 @@ void RegisterBuildCommand(CLI::App& app) {
     int ransac_iterations = 2000;
     int keyframe_interval = MappingOptions().keyframe_interval;
     int features = KltTrackerOptions().target_features;
+    int detection_min_missing = KltTrackerOptions().detection_min_missing;
     bool no_affine = false;
     int affine_interval = KltTrackerOptions().affine_interval;
     bool quiet = false;
@@ -49,6 +50,10 @@ void RegisterBuildCommand(CLI::App& app) {
                   "Bundle-adjust every n-th frame (1: all frames)");
   cmd->add_option("--features", args->features,
                   "Features the tracker keeps alive per frame");
+  cmd->add_option("--detection-min-missing", args->detection_min_missing,
+                  "Detect new features only once this many are missing "
+                  "(1: every frame short of --features)")
+      ->check(CLI::Range(1, 1000000));
   cmd->add_flag("--no-affine-refinement", args->no_affine,
                 "Track frame to frame only (no alignment with each "
                 "feature's reference patch)");
@@ -74,6 +79,7 @@ void RegisterBuildCommand(CLI::App& app) {
     options.planes.ransac_iterations = args->ransac_iterations;
     options.keyframe_interval = args->keyframe_interval;
     options.tracking.target_features = args->features;
+    options.tracking.detection_min_missing = args->detection_min_missing;
     options.tracking.affine_refinement = !args->no_affine;
     options.tracking.affine_interval = args->affine_interval;
     options.show_progress = !args->quiet;

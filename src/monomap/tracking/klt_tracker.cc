@@ -37,6 +37,8 @@ void KltTrackerOptions::Check() const {
   CheckOption(forward_backward_threshold_px > 0.0,
               "forward_backward_threshold_px", "must be > 0");
   CheckOption(border_margin_px >= 0.0, "border_margin_px", "must be >= 0");
+  CheckOption(detection_min_missing >= 1, "detection_min_missing",
+              "must be >= 1");
   CheckOption(grid_cols >= 1 && grid_rows >= 1, "grid_cols/grid_rows",
               "must be >= 1");
   affine.Check();
@@ -277,8 +279,14 @@ void KltTracker::Detect(int frame_index, const cv::Mat& grey,
   int total = static_cast<int>(active_.size());
   // Detection only tops up to the target: features are lost continuously
   // (motion, occlusion), and each top-up serves the short cells first, so
-  // the spread recovers without ever exceeding target_features.
-  if (total >= options_.target_features) return;
+  // the spread recovers without ever exceeding target_features. It waits
+  // until detection_min_missing are missing, since every detection
+  // computes the corner response of the whole image.
+  const int missing = options_.target_features - total;
+  if (missing <
+      std::clamp(options_.detection_min_missing, 1, options_.target_features)) {
+    return;
+  }
 
   // Search only inside the margin and away from existing features (so new
   // ones do not duplicate them).

@@ -284,6 +284,40 @@ TEST(KltTrackerTest, FeaturesLeavingTheImageAreDroppedAndReplaced) {
   EXPECT_LT(Percentile(errors, 0.99), 0.5);
 }
 
+// Detection tops up only once detection_min_missing features are missing,
+// and then fills up to the target; waiting means fewer detections.
+TEST(KltTrackerTest, DetectionWaitsUntilEnoughFeaturesAreMissing) {
+  const cv::Mat base = MakeTexture(1400, 800, 3);
+  constexpr int kFrames = 30;
+  const Sequence seq = MakeSequence(base, kFrames, {-9.0, -2.5, 0.0, 0.0});
+  std::vector<int> detections;
+  for (const int min_missing : {1, 40}) {
+    KltTrackerOptions options;
+    options.detection_min_missing = min_missing;
+    KltTracker tracker(options);
+    tracker.Track(0, seq.frames[0]);
+    int frames_with_detection = 0;
+    for (int k = 1; k < kFrames; ++k) {
+      tracker.Track(k, seq.frames[k]);
+      const KltFrameStats& s = tracker.LastFrameStats();
+      const int missing_before = options.target_features - s.tracked;
+      if (s.detected > 0) {
+        ++frames_with_detection;
+        EXPECT_GE(missing_before, min_missing) << "frame " << k;
+        EXPECT_GE(s.total, 0.97 * options.target_features) << "frame " << k;
+      } else {
+        EXPECT_LT(missing_before, min_missing) << "frame " << k;
+      }
+      EXPECT_LE(s.total, options.target_features);
+    }
+    detections.push_back(frames_with_detection);
+  }
+  std::printf("frames with detection: %d (every frame short), %d (40 short)\n",
+              detections[0], detections[1]);
+  EXPECT_GE(detections[0], kFrames - 3);
+  EXPECT_LE(detections[1], detections[0] / 2);
+}
+
 TEST(KltTrackerTest, OccludedFeaturesAreDroppedByForwardBackwardCheck) {
   const cv::Mat base = MakeTexture(1000, 800, 4);
   const cv::Mat other = MakeTexture(kWidth, kHeight, 5);
