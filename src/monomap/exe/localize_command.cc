@@ -44,7 +44,7 @@ void RegisterLocalizeCommand(CLI::App& app) {
   cmd->add_option("--mcc-size", a->mcc_size,
                   "WxH of the renders MCC tracks against (default 160x120)");
   cmd->add_option("--mcc-top-k", a->mcc_top_k,
-                  "Heaviest particles MCC corrects per update (default 8)");
+                  "Heaviest particles MCC corrects per update (default 64)");
   cmd->add_option("--measure-size", a->measure_size,
                   "WxH of the renders the weights compare (default 80x60)");
   cmd->add_option("--first-frame", a->first_frame, "First dataset frame");

@@ -6,12 +6,11 @@
 // correction creates are merged after it.
 #pragma once
 
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
-#include <opencv2/core.hpp>
 
 #include "monomap/io/dataset.h"
 #include "monomap/localization/mcc.h"
@@ -48,8 +47,10 @@ struct LocalizerOptions {
   OdometryNoise6d noise6d;
   MeasurementOptions measurement;
   MccOptions mcc;
-  // MCC: how many of the heaviest particles are corrected per step.
-  int mcc_top_k = 8;
+  // MCC: how many of the heaviest particles are corrected per step. Many
+  // while the particles are spread (global start: room seed 5 localized
+  // with 64, lost with 8); once they have merged into a few, all are.
+  int mcc_top_k = 64;
   // MCC: the estimate of each update is corrected once more against a
   // render of refine_mcc's (larger) size; only the output changes, not the
   // particles. The particle corrections run small for speed, and at
@@ -63,6 +64,9 @@ struct LocalizerOptions {
     o.width = 1024;
     o.height = 768;
     o.klt_window = 21;
+    // The estimate is near the truth already; a deeper pyramid lets
+    // tracks at the map's silhouette run off (see MccOptions::klt_levels).
+    o.klt_levels = 2;
     return o;
   }();
   // MCC: particles closer than this after resampling are merged (m, deg).
@@ -108,10 +112,10 @@ struct OdometryIncrement {
 };
 
 struct LocalizerStepStats {
-  int particles = 0;         // after resampling (or merging)
+  int particles = 0;          // after resampling (or merging)
   int particles_weighed = 0;  // rendered this step
-  double ess = 0.0;          // before resampling
-  double max_weight = 0.0;   // normalized, before resampling
+  double ess = 0.0;           // before resampling
+  double max_weight = 0.0;    // normalized, before resampling
   double best_ncc = 0.0;
   double cluster_weight = 0.0;  // weight share of the estimate's cluster
   int kld_bins = 0;
@@ -119,7 +123,7 @@ struct LocalizerStepStats {
   int mcc_attempted = 0;
   int mcc_accepted = 0;
   int merged = 0;
-  bool refined = false;      // the estimate was refined (refine_estimate)
+  bool refined = false;  // the estimate was refined (refine_estimate)
   bool resampled = false;
   double weigh_seconds = 0.0;  // rendering + NCC of every particle
   double mcc_seconds = 0.0;    // corrections (MCC only), refinement included

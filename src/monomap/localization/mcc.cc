@@ -1,12 +1,11 @@
 #include "monomap/localization/mcc.h"
 
 #include <cmath>
-#include <vector>
-
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
+#include <vector>
 
 #include "monomap/util/error.h"
 
@@ -47,7 +46,8 @@ MonteCarloCorrector::MonteCarloCorrector(const Renderer* renderer,
 namespace {
 
 cv::Mat CvFromRigid(const Rigid3d& cam_from_world, cv::Mat* tvec) {
-  const Eigen::Vector3d w = RotationVectorFromQuaternion(cam_from_world.rotation);
+  const Eigen::Vector3d w =
+      RotationVectorFromQuaternion(cam_from_world.rotation);
   cv::Mat rvec = (cv::Mat_<double>(3, 1) << w.x(), w.y(), w.z());
   *tvec = (cv::Mat_<double>(3, 1) << cam_from_world.translation.x(),
            cam_from_world.translation.y(), cam_from_world.translation.z());
@@ -132,8 +132,8 @@ bool MonteCarloCorrector::Round(const cv::Mat& live_raw, const Rigid3d& start,
   stats->tracked = static_cast<int>(object.size());
   if (stats->tracked < o.min_inliers) return false;
 
-  const cv::Mat k = (cv::Mat_<double>(3, 3) << c.fx, 0, c.cx, 0, c.fy, c.cy,
-                     0, 0, 1);
+  const cv::Mat k =
+      (cv::Mat_<double>(3, 3) << c.fx, 0, c.cx, 0, c.fy, c.cy, 0, 0, 1);
   cv::Mat tvec;
   cv::Mat rvec = CvFromRigid(start.Inverse(), &tvec);
   std::vector<int> inliers;
@@ -151,16 +151,35 @@ bool MonteCarloCorrector::Round(const cv::Mat& live_raw, const Rigid3d& start,
     in_obj.push_back(object[i]);
     in_img.push_back(image[i]);
   }
+  auto rms = [&](const cv::Mat& r, const cv::Mat& t) {
+    std::vector<cv::Point2d> proj;
+    cv::projectPoints(in_obj, r, t, k, cv::noArray(), proj);
+    double sum_sq = 0.0;
+    for (size_t i = 0; i < proj.size(); ++i) {
+      const cv::Point2d d = proj[i] - in_img[i];
+      sum_sq += d.dot(d);
+    }
+    return std::sqrt(sum_sq / proj.size());
+  };
+  // The pose solvePnPRansac returns for its inliers occasionally runs off
+  // (tens of px of error, metres away, on simulated hallways), so the
+  // inliers are fitted by Levenberg-Marquardt from both that pose and the
+  // start pose, and the better fit is kept.
+  cv::Mat tvec_start;
+  cv::Mat rvec_start = CvFromRigid(start.Inverse(), &tvec_start);
   cv::solvePnPRefineLM(in_obj, in_img, k, cv::noArray(), rvec, tvec);
-  std::vector<cv::Point2d> proj;
-  cv::projectPoints(in_obj, rvec, tvec, k, cv::noArray(), proj);
-  double sum_sq = 0.0;
-  for (size_t i = 0; i < proj.size(); ++i) {
-    const cv::Point2d d = proj[i] - in_img[i];
-    sum_sq += d.dot(d);
+  cv::solvePnPRefineLM(in_obj, in_img, k, cv::noArray(), rvec_start,
+                       tvec_start);
+  double best_rms = rms(rvec, tvec);
+  const double start_rms = rms(rvec_start, tvec_start);
+  if (start_rms < best_rms) {
+    best_rms = start_rms;
+    rvec = rvec_start;
+    tvec = tvec_start;
   }
   stats->inliers = static_cast<int>(inliers.size());
-  stats->rms_reprojection_px = std::sqrt(sum_sq / proj.size());
+  stats->rms_reprojection_px = best_rms;
+  if (!(best_rms <= o.ransac_threshold_px)) return false;
   *out = RigidFromCv(rvec, tvec).Inverse();
   return true;
 }

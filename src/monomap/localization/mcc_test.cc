@@ -1,9 +1,9 @@
 #include "monomap/localization/mcc.h"
 
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <cstdio>
-
-#include <gtest/gtest.h>
 
 #include "monomap/localization/measurement_model.h"
 #include "monomap/localization/particle_filter.h"
@@ -27,9 +27,8 @@ TEST(Mcc, CorrectsAnOffsetParticle) {
     const Rigid3d truth = WorldFromCamOfBase(base, mount);
     const cv::Mat raw =
         test_scene::LiveImage(renderer, camera, truth, 0.8, 15, 2.0, ++n);
-    const cv::Mat live = LiveImagePreparer::Downscale(prep.Undistort(raw),
-                                                      mcc.options().width,
-                                                      mcc.options().height);
+    const cv::Mat live = LiveImagePreparer::Downscale(
+        prep.Undistort(raw), mcc.options().width, mcc.options().height);
     // Offset (2 cm, -1 cm) in the world and 1 degree about the camera's
     // vertical axis.
     const Rigid3d offset(
@@ -48,6 +47,40 @@ TEST(Mcc, CorrectsAnOffsetParticle) {
     EXPECT_GE(r.inliers, 30);
     EXPECT_LT(r.rms_reprojection_px, 0.2);
     EXPECT_NEAR(r.translation_change_m, std::sqrt(0.0005), 0.005);
+  }
+}
+
+// The basin reaches well beyond a few centimetres: 20 cm back along the
+// optical axis (the view shrinks by ~10 %) and 2 degrees of yaw.
+TEST(Mcc, CorrectsTwentyCentimetresAlongTheViewAxis) {
+  const Map map = test_scene::RoomMap();
+  const Renderer renderer(map);
+  const Camera camera = test_scene::LiveCamera();
+  const MonteCarloCorrector mcc(&renderer, camera);
+  const LiveImagePreparer prep(camera);
+  const Rigid3d mount = test_scene::BaseFromCam();
+  int n = 0;
+  for (const Pose2d& base : {Pose2d{0.3, 0.2, 0.3}, Pose2d{1.2, -0.5, -0.8},
+                             Pose2d{0.5, 0.6, 2.5}}) {
+    const Rigid3d truth = WorldFromCamOfBase(base, mount);
+    const cv::Mat raw =
+        test_scene::LiveImage(renderer, camera, truth, 0.8, 15, 2.0, ++n);
+    const cv::Mat live = LiveImagePreparer::Downscale(
+        prep.Undistort(raw), mcc.options().width, mcc.options().height);
+    const Rigid3d offset(
+        QuaternionFromRotationVector({0, 0, 2 * kDeg}) * truth.rotation,
+        truth.translation + truth.rotation * Eigen::Vector3d(0, 0, -0.2));
+    const MccResult r = mcc.Correct(live, offset);
+    ASSERT_TRUE(r.accepted)
+        << "pose " << n << ": inliers " << r.inliers << " tracked " << r.tracked
+        << " corners " << r.corners;
+    const double et = (r.world_from_cam.translation - truth.translation).norm();
+    const double er =
+        AngleBetween(r.world_from_cam.rotation, truth.rotation) / kDeg;
+    std::printf("pose %d from 20 cm: error %.2f mm %.3f deg, inliers %d/%d\n",
+                n, et * 1e3, er, r.inliers, r.tracked);
+    EXPECT_LT(et, 0.01) << "pose " << n;
+    EXPECT_LT(er, 0.3) << "pose " << n;
   }
 }
 

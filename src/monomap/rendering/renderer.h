@@ -8,9 +8,8 @@
 #pragma once
 
 #include <memory>
-#include <vector>
-
 #include <opencv2/core.hpp>
+#include <vector>
 
 #include "monomap/camera/camera.h"
 #include "monomap/geometry/rigid3.h"
@@ -18,10 +17,25 @@
 
 namespace monomap {
 
+// Which size of a pixel's texel footprint picks the mip level. Seen
+// obliquely, the footprint is a long parallelogram.
+enum class MipFootprint {
+  // Its area (the geometric mean of its axes): the blur a camera's own box
+  // downscaling gives, sharp across the long axis, slightly aliased along
+  // it. The default: renders then match area-downscaled live images.
+  kArea,
+  // Its longest axis (the rule of OpenGL without anisotropic filtering):
+  // never aliases, but blurs oblique floors and walls far beyond what a
+  // camera sees (floor boards vanish at 160x120).
+  kLongestAxis,
+};
+
 struct RendererOptions {
   // Filter minified textures with a mip pyramid (2x2 box, premultiplied
   // alpha). Off gives plain bilinear sampling of the full texture (aliases).
   bool use_mipmaps = true;
+  // Footprint measure that picks the mip level (see MipFootprint).
+  MipFootprint mip_footprint = MipFootprint::kArea;
   // Added to log2(texel footprint) before picking the mip level: > 0 blurs
   // more, < 0 keeps more detail (and aliases more).
   double mip_bias = 0.0;
@@ -85,11 +99,10 @@ class Renderer {
   // Renders every pose (e.g. the particles of a filter) in parallel with
   // oneTBB. greys (and depths if not null) are resized to poses.size();
   // their Mats are reused when they already have the right size.
-  std::vector<RenderStats> RenderBatch(const Camera& camera,
-                                       const std::vector<Rigid3d>& poses,
-                                       std::vector<cv::Mat>* greys,
-                                       std::vector<cv::Mat>* depths =
-                                           nullptr) const;
+  std::vector<RenderStats> RenderBatch(
+      const Camera& camera, const std::vector<Rigid3d>& poses,
+      std::vector<cv::Mat>* greys,
+      std::vector<cv::Mat>* depths = nullptr) const;
 
   const RendererOptions& options() const { return options_; }
   int num_planes() const;
