@@ -31,15 +31,27 @@ void MccOptions::Check() const {
   CheckOption(max_translation_m > 0, "mcc.max_translation_m", "must be > 0");
   CheckOption(max_rotation_deg > 0, "mcc.max_rotation_deg", "must be > 0");
   CheckOption(iterations >= 1, "mcc.iterations", "must be >= 1");
+  CheckOption(std::isfinite(extra_mip_bias) && std::abs(extra_mip_bias) <= 4,
+              "mcc.extra_mip_bias", "must be finite, within [-4, 4]");
 }
+
+namespace {
+
+// The caller's renderer with the extra mip bias (options checked first).
+Renderer MccRenderer(const Renderer* renderer, const MccOptions& options) {
+  options.Check();
+  if (renderer == nullptr) throw OptionsError("mcc: null renderer");
+  return renderer->WithMipBias(renderer->options().mip_bias +
+                               options.extra_mip_bias);
+}
+
+}  // namespace
 
 MonteCarloCorrector::MonteCarloCorrector(const Renderer* renderer,
                                          const Camera& camera,
                                          const MccOptions& options)
-    : renderer_(renderer), options_(options) {
-  options_.Check();
+    : renderer_(MccRenderer(renderer, options)), options_(options) {
   camera.Check();
-  if (renderer_ == nullptr) throw OptionsError("mcc: null renderer");
   render_camera_ = camera.Pinhole().Scaled(options_.width, options_.height);
 }
 
@@ -68,7 +80,7 @@ bool MonteCarloCorrector::Round(const cv::Mat& live_raw, const Rigid3d& start,
                                 Rigid3d* out, MccResult* stats) const {
   const MccOptions& o = options_;
   cv::Mat render, depth;
-  renderer_->Render(render_camera_, start, &render, &depth);
+  renderer_.Render(render_camera_, start, &render, &depth);
   // Corners only well inside the map's silhouette.
   cv::Mat mask = depth > 0.0f;
   if (o.border_px > 0) {

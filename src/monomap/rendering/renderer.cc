@@ -169,7 +169,7 @@ Renderer::Renderer(const std::vector<TexturedPlane>& planes,
       default:
         throw InputError(name + ": texture must have 1, 3 or 4 channels");
     }
-    auto data = std::make_unique<PlaneData>();
+    auto data = std::make_shared<PlaneData>();
     data->frame = plane.frame;
     data->pixels_per_meter = plane.pixels_per_meter;
     const double ppm = plane.pixels_per_meter;
@@ -207,6 +207,15 @@ Renderer::Renderer(const std::vector<TexturedPlane>& planes,
 }
 
 int Renderer::num_planes() const { return static_cast<int>(planes_.size()); }
+
+Renderer Renderer::WithMipBias(double mip_bias) const {
+  Renderer r;
+  r.options_ = options_;
+  r.options_.mip_bias = mip_bias;
+  r.options_.Check();
+  r.planes_ = planes_;
+  return r;
+}
 
 size_t Renderer::MemoryBytes() const {
   size_t bytes = 0;

@@ -104,6 +104,10 @@ class Renderer {
       std::vector<cv::Mat>* greys,
       std::vector<cv::Mat>* depths = nullptr) const;
 
+  // A renderer of the same planes (the pyramids are shared, not copied)
+  // that picks mip levels with another bias.
+  Renderer WithMipBias(double mip_bias) const;
+
   const RendererOptions& options() const { return options_; }
   int num_planes() const;
   // Bytes held by the pyramids (for reports).
@@ -115,8 +119,11 @@ class Renderer {
   RenderStats RenderImpl(const Camera& camera, const Rigid3d& world_from_cam,
                          cv::Mat* image, cv::Mat* depth) const;
 
+  Renderer() = default;
+
   RendererOptions options_;
-  std::vector<std::unique_ptr<PlaneData>> planes_;
+  // Built once, then only read: shared by WithMipBias copies.
+  std::vector<std::shared_ptr<const PlaneData>> planes_;
 };
 
 }  // namespace monomap
