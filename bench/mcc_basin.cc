@@ -57,6 +57,8 @@ int Run(int argc, char** argv) {
   app.add_option("--klt-levels", mo.klt_levels, "KLT pyramid levels");
   app.add_option("--ransac-threshold", mo.ransac_threshold_px,
                  "PnP inlier threshold (px)");
+  app.add_option("--extra-mip-bias", mo.extra_mip_bias,
+                 "Mip bias MCC adds to the renderer's");
   app.add_option("--max-translation", mo.max_translation_m,
                  "Largest accepted correction (m)");
   CLI11_PARSE(app, argc, argv);

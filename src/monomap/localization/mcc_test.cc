@@ -14,27 +14,46 @@ namespace {
 
 constexpr double kDeg = M_PI / 180.0;
 
-TEST(Mcc, CorrectsAnOffsetParticle) {
-  const Map map = test_scene::RoomMap();
-  const Renderer renderer(map);
-  const Camera camera = test_scene::LiveCamera();
-  const MonteCarloCorrector mcc(&renderer, camera);
-  const LiveImagePreparer prep(camera);
-  const Rigid3d mount = test_scene::BaseFromCam();
+// The synthetic room, a corrector on it and live views of three poses.
+class MccTest : public ::testing::Test {
+ protected:
+  struct View {
+    Rigid3d truth;
+    cv::Mat live;  // prepared for the corrector
+  };
+  std::vector<View> Views() const {
+    std::vector<View> views;
+    int n = 0;
+    for (const Pose2d& base : {Pose2d{0.3, 0.2, 0.3}, Pose2d{1.2, -0.5, -0.8},
+                               Pose2d{0.5, 0.6, 2.5}}) {
+      View v;
+      v.truth = WorldFromCamOfBase(base, test_scene::BaseFromCam());
+      const cv::Mat raw =
+          test_scene::LiveImage(renderer_, camera_, v.truth, 0.8, 15, 2.0, ++n);
+      v.live = LiveImagePreparer::Downscale(
+          prep_.Undistort(raw), mcc_.options().width, mcc_.options().height);
+      views.push_back(std::move(v));
+    }
+    return views;
+  }
+
+  const Map map_ = test_scene::RoomMap();
+  const Renderer renderer_{map_};
+  const Camera camera_ = test_scene::LiveCamera();
+  const MonteCarloCorrector mcc_{&renderer_, camera_};
+  const LiveImagePreparer prep_{camera_};
+};
+
+TEST_F(MccTest, CorrectsAnOffsetParticle) {
   int n = 0;
-  for (const Pose2d& base : {Pose2d{0.3, 0.2, 0.3}, Pose2d{1.2, -0.5, -0.8},
-                             Pose2d{0.5, 0.6, 2.5}}) {
-    const Rigid3d truth = WorldFromCamOfBase(base, mount);
-    const cv::Mat raw =
-        test_scene::LiveImage(renderer, camera, truth, 0.8, 15, 2.0, ++n);
-    const cv::Mat live = LiveImagePreparer::Downscale(
-        prep.Undistort(raw), mcc.options().width, mcc.options().height);
+  for (const auto& [truth, live] : Views()) {
+    ++n;
     // Offset (2 cm, -1 cm) in the world and 1 degree about the camera's
     // vertical axis.
     const Rigid3d offset(
         QuaternionFromRotationVector({0, 1 * kDeg, 0}) * truth.rotation,
         truth.translation + Eigen::Vector3d(0.02, -0.01, 0));
-    const MccResult r = mcc.Correct(live, offset);
+    const MccResult r = mcc_.Correct(live, offset);
     ASSERT_TRUE(r.accepted) << "inliers " << r.inliers << " tracked "
                             << r.tracked << " corners " << r.corners;
     const double et = (r.world_from_cam.translation - truth.translation).norm();
@@ -52,25 +71,14 @@ TEST(Mcc, CorrectsAnOffsetParticle) {
 
 // The basin reaches well beyond a few centimetres: 20 cm back along the
 // optical axis (the view shrinks by ~10 %) and 2 degrees of yaw.
-TEST(Mcc, CorrectsTwentyCentimetresAlongTheViewAxis) {
-  const Map map = test_scene::RoomMap();
-  const Renderer renderer(map);
-  const Camera camera = test_scene::LiveCamera();
-  const MonteCarloCorrector mcc(&renderer, camera);
-  const LiveImagePreparer prep(camera);
-  const Rigid3d mount = test_scene::BaseFromCam();
+TEST_F(MccTest, CorrectsTwentyCentimetresAlongTheViewAxis) {
   int n = 0;
-  for (const Pose2d& base : {Pose2d{0.3, 0.2, 0.3}, Pose2d{1.2, -0.5, -0.8},
-                             Pose2d{0.5, 0.6, 2.5}}) {
-    const Rigid3d truth = WorldFromCamOfBase(base, mount);
-    const cv::Mat raw =
-        test_scene::LiveImage(renderer, camera, truth, 0.8, 15, 2.0, ++n);
-    const cv::Mat live = LiveImagePreparer::Downscale(
-        prep.Undistort(raw), mcc.options().width, mcc.options().height);
+  for (const auto& [truth, live] : Views()) {
+    ++n;
     const Rigid3d offset(
         QuaternionFromRotationVector({0, 0, 2 * kDeg}) * truth.rotation,
         truth.translation + truth.rotation * Eigen::Vector3d(0, 0, -0.2));
-    const MccResult r = mcc.Correct(live, offset);
+    const MccResult r = mcc_.Correct(live, offset);
     ASSERT_TRUE(r.accepted)
         << "pose " << n << ": inliers " << r.inliers << " tracked " << r.tracked
         << " corners " << r.corners;
