@@ -6,11 +6,12 @@
 // correction creates are merged after it.
 #pragma once
 
-#include <Eigen/Core>
-#include <opencv2/core.hpp>
 #include <optional>
 #include <string>
 #include <vector>
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
 
 #include "monomap/io/dataset.h"
 #include "monomap/localization/mcc.h"
@@ -112,10 +113,10 @@ struct OdometryIncrement {
 };
 
 struct LocalizerStepStats {
-  int particles = 0;          // after resampling (or merging)
+  int particles = 0;         // after resampling (or merging)
   int particles_weighed = 0;  // rendered this step
-  double ess = 0.0;           // before resampling
-  double max_weight = 0.0;    // normalized, before resampling
+  double ess = 0.0;          // before resampling
+  double max_weight = 0.0;   // normalized, before resampling
   double best_ncc = 0.0;
   double cluster_weight = 0.0;  // weight share of the estimate's cluster
   int kld_bins = 0;
@@ -123,7 +124,7 @@ struct LocalizerStepStats {
   int mcc_attempted = 0;
   int mcc_accepted = 0;
   int merged = 0;
-  bool refined = false;  // the estimate was refined (refine_estimate)
+  bool refined = false;      // the estimate was refined (refine_estimate)
   bool resampled = false;
   double weigh_seconds = 0.0;  // rendering + NCC of every particle
   double mcc_seconds = 0.0;    // corrections (MCC only), refinement included

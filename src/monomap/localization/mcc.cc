@@ -1,11 +1,12 @@
 #include "monomap/localization/mcc.h"
 
 #include <cmath>
+#include <vector>
+
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
-#include <vector>
 
 #include "monomap/util/error.h"
 
@@ -58,8 +59,7 @@ MonteCarloCorrector::MonteCarloCorrector(const Renderer* renderer,
 namespace {
 
 cv::Mat CvFromRigid(const Rigid3d& cam_from_world, cv::Mat* tvec) {
-  const Eigen::Vector3d w =
-      RotationVectorFromQuaternion(cam_from_world.rotation);
+  const Eigen::Vector3d w = RotationVectorFromQuaternion(cam_from_world.rotation);
   cv::Mat rvec = (cv::Mat_<double>(3, 1) << w.x(), w.y(), w.z());
   *tvec = (cv::Mat_<double>(3, 1) << cam_from_world.translation.x(),
            cam_from_world.translation.y(), cam_from_world.translation.z());
@@ -144,10 +144,12 @@ bool MonteCarloCorrector::Round(const cv::Mat& live_raw, const Rigid3d& start,
   stats->tracked = static_cast<int>(object.size());
   if (stats->tracked < o.min_inliers) return false;
 
-  const cv::Mat k =
-      (cv::Mat_<double>(3, 3) << c.fx, 0, c.cx, 0, c.fy, c.cy, 0, 0, 1);
+  const cv::Mat k = (cv::Mat_<double>(3, 3) << c.fx, 0, c.cx, 0, c.fy, c.cy,
+                     0, 0, 1);
   cv::Mat tvec;
   cv::Mat rvec = CvFromRigid(start.Inverse(), &tvec);
+  // RANSAC overwrites its guess; the start pose is refined again below.
+  cv::Mat rvec_start = rvec.clone(), tvec_start = tvec.clone();
   std::vector<int> inliers;
   const bool ok = cv::solvePnPRansac(
       object, image, k, cv::noArray(), rvec, tvec, /*useExtrinsicGuess=*/true,
@@ -177,8 +179,6 @@ bool MonteCarloCorrector::Round(const cv::Mat& live_raw, const Rigid3d& start,
   // (tens of px of error, metres away, on simulated hallways), so the
   // inliers are fitted by Levenberg-Marquardt from both that pose and the
   // start pose, and the better fit is kept.
-  cv::Mat tvec_start;
-  cv::Mat rvec_start = CvFromRigid(start.Inverse(), &tvec_start);
   cv::solvePnPRefineLM(in_obj, in_img, k, cv::noArray(), rvec, tvec);
   cv::solvePnPRefineLM(in_obj, in_img, k, cv::noArray(), rvec_start,
                        tvec_start);

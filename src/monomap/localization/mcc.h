@@ -29,9 +29,10 @@ struct MccOptions {
   // small window: at 160x120 the top of a 3-level pyramid is 20x15 px, its
   // windows span the map's silhouette against the background, and most
   // tracks run off (simulated room: 33 of 71 corners tracked at the true
-  // pose with 15 px / 3 levels, 46 of 70 with 11 px / 1 level; one
-  // correction from 20 cm behind the truth accepted in 0 % of the frames,
-  // then in 62 %; bench/mcc_basin).
+  // pose with 15 px / 3 levels, 46 of 70 with 11 px / 1 level; with the
+  // other MCC settings of the same change, a correction from 20 cm behind
+  // the truth is accepted in 71 % of the frames instead of 0 %;
+  // bench/mcc_basin).
   int klt_window = 11;
   int klt_levels = 1;
   // Forward-backward KLT check: largest round-trip error (px).
@@ -48,8 +49,9 @@ struct MccOptions {
   double max_rotation_deg = 10.0;
   // Added to the renderer's mip bias for the renders tracked here: half a
   // level blurrier tames aliasing along oblique views, which KLT minds more
-  // than the weights do (synthetic 6-DoF tracking 0.37 mm instead of 0.80
-  // mm; simulated room seed 5, global start: localized instead of lost).
+  // than the weights do (synthetic 6-DoF tracking 0.61 mm, 0.43 refined,
+  // instead of 0.88 and 0.80; simulated room seed 5, global start:
+  // localized instead of lost).
   double extra_mip_bias = 0.5;
   // Render-track-solve rounds; the second one starts from an almost
   // aligned render and removes most of the first round's bias.

@@ -1,9 +1,10 @@
 #include "monomap/localization/mcc.h"
 
-#include <gtest/gtest.h>
-
 #include <cmath>
 #include <cstdio>
+#include <vector>
+
+#include <gtest/gtest.h>
 
 #include "monomap/localization/measurement_model.h"
 #include "monomap/localization/particle_filter.h"

@@ -1,14 +1,14 @@
 #include "monomap/rendering/renderer.h"
 
-#include <tbb/parallel_for.h>
-
-#include <Eigen/Dense>
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
-#include <opencv2/imgproc.hpp>
 #include <string>
+
+#include <Eigen/Dense>
+#include <opencv2/imgproc.hpp>
+#include <tbb/parallel_for.h>
 
 #include "monomap/geometry/polygon.h"
 #include "monomap/util/error.h"
@@ -25,7 +25,7 @@ constexpr int kSpan = 16;
 // padded by one texel of zeros on every side so that bilinear sampling at
 // the border needs no clamping and fades alpha to 0 outside the texture.
 struct Level {
-  int width = 0;  // texels, without padding
+  int width = 0;   // texels, without padding
   int height = 0;
   int stride = 0;  // floats per padded row
   std::vector<float> data;
@@ -157,15 +157,9 @@ Renderer::Renderer(const std::vector<TexturedPlane>& planes,
     }
     cv::Mat bgra;
     switch (plane.texture.channels()) {
-      case 4:
-        bgra = plane.texture;
-        break;
-      case 3:
-        cv::cvtColor(plane.texture, bgra, cv::COLOR_BGR2BGRA);
-        break;
-      case 1:
-        cv::cvtColor(plane.texture, bgra, cv::COLOR_GRAY2BGRA);
-        break;
+      case 4: bgra = plane.texture; break;
+      case 3: cv::cvtColor(plane.texture, bgra, cv::COLOR_BGR2BGRA); break;
+      case 1: cv::cvtColor(plane.texture, bgra, cv::COLOR_GRAY2BGRA); break;
       default:
         throw InputError(name + ": texture must have 1, 3 or 4 channels");
     }
@@ -245,8 +239,7 @@ RenderStats Renderer::RenderColor(const Camera& camera,
 std::vector<RenderStats> Renderer::RenderBatch(
     const Camera& camera, const std::vector<Rigid3d>& poses,
     std::vector<cv::Mat>* greys, std::vector<cv::Mat>* depths) const {
-  if (greys == nullptr)
-    throw OptionsError("RenderBatch: greys must not be null");
+  if (greys == nullptr) throw OptionsError("RenderBatch: greys must not be null");
   const int n = static_cast<int>(poses.size());
   greys->resize(n);
   if (depths != nullptr) depths->resize(n);
@@ -266,12 +259,12 @@ std::vector<RenderStats> Renderer::RenderBatch(
 
 template <int C>
 RenderStats Renderer::RenderImpl(const Camera& camera,
-                                 const Rigid3d& world_from_cam, cv::Mat* image,
-                                 cv::Mat* depth) const {
+                                 const Rigid3d& world_from_cam,
+                                 cv::Mat* image, cv::Mat* depth) const {
   constexpr int kOut = C == 2 ? 1 : 3;
-  CheckOption(
-      camera.width > 0 && camera.height > 0 && camera.fx > 0 && camera.fy > 0,
-      "camera", "needs a positive size and focal lengths");
+  CheckOption(camera.width > 0 && camera.height > 0 && camera.fx > 0 &&
+                  camera.fy > 0,
+              "camera", "needs a positive size and focal lengths");
   const int width = camera.width;
   const int height = camera.height;
   image->create(height, width, C == 2 ? CV_8UC1 : CV_8UC3);
@@ -364,8 +357,7 @@ RenderStats Renderer::RenderImpl(const Camera& camera,
         }
         for (double b : {b0, b1}) {
           if ((p.y() - b) * (q.y() - b) < 0) {
-            const double x =
-                p.x() + (b - p.y()) / (q.y() - p.y()) * (q.x() - p.x());
+            const double x = p.x() + (b - p.y()) / (q.y() - p.y()) * (q.x() - p.x());
             lo = std::min(lo, x);
             hi = std::max(hi, x);
           }
@@ -391,8 +383,7 @@ RenderStats Renderer::RenderImpl(const Camera& camera,
         int level = 0;
         if (num_levels > 1) {
           const double uc = 0.5 * (s0 + s1);
-          const Eigen::Vector3d t =
-              texel_from_pixel * Eigen::Vector3d(uc, v, 1);
+          const Eigen::Vector3d t = texel_from_pixel * Eigen::Vector3d(uc, v, 1);
           if (t.z() > 0) {
             const double x = t.x() / t.z(), y = t.y() / t.z();
             const Eigen::Matrix3d& hd = texel_from_pixel;

@@ -8,8 +8,9 @@
 #pragma once
 
 #include <memory>
-#include <opencv2/core.hpp>
 #include <vector>
+
+#include <opencv2/core.hpp>
 
 #include "monomap/camera/camera.h"
 #include "monomap/geometry/rigid3.h"
@@ -99,10 +100,11 @@ class Renderer {
   // Renders every pose (e.g. the particles of a filter) in parallel with
   // oneTBB. greys (and depths if not null) are resized to poses.size();
   // their Mats are reused when they already have the right size.
-  std::vector<RenderStats> RenderBatch(
-      const Camera& camera, const std::vector<Rigid3d>& poses,
-      std::vector<cv::Mat>* greys,
-      std::vector<cv::Mat>* depths = nullptr) const;
+  std::vector<RenderStats> RenderBatch(const Camera& camera,
+                                       const std::vector<Rigid3d>& poses,
+                                       std::vector<cv::Mat>* greys,
+                                       std::vector<cv::Mat>* depths =
+                                           nullptr) const;
 
   // A renderer of the same planes (the pyramids are shared, not copied)
   // that picks mip levels with another bias.

@@ -1,10 +1,10 @@
 #include "monomap/rendering/renderer.h"
 
-#include <gtest/gtest.h>
-
 #include <cmath>
 #include <cstdio>
 #include <functional>
+
+#include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
 #include "monomap/util/error.h"
@@ -61,8 +61,7 @@ TexturedPlane MakePlane(const Vector3d& origin, const Vector3d& u,
 }
 
 double Smooth(double s, double t) {
-  return 128 +
-         90 * std::sin(2 * M_PI * s / 0.1) * std::cos(2 * M_PI * t / 0.08);
+  return 128 + 90 * std::sin(2 * M_PI * s / 0.1) * std::cos(2 * M_PI * t / 0.08);
 }
 
 // Ray through pixel (u, v) meets the plane z = z0 at world point *x and
@@ -110,14 +109,14 @@ TEST(RendererTest, SinglePlaneMatchesAnalyticProjection) {
       if (hit && s > margin && s < 0.8 - margin && t > margin &&
           t < 0.6 - margin) {
         sum_abs += std::abs(grey.at<uint8_t>(v, u) - Smooth(s, t));
-        max_rel_depth =
-            std::max(max_rel_depth, std::abs(depth.at<float>(v, u) - z) / z);
+        max_rel_depth = std::max(
+            max_rel_depth, std::abs(depth.at<float>(v, u) - z) / z);
         ++compared;
       } else if (!hit || s < -margin || s > 0.8 + margin || t < -margin ||
                  t > 0.6 + margin) {
         ++background_checked;
-        background_wrong +=
-            grey.at<uint8_t>(v, u) != 7 || depth.at<float>(v, u) != 0.f;
+        background_wrong += grey.at<uint8_t>(v, u) != 7 ||
+                            depth.at<float>(v, u) != 0.f;
       }
     }
   }
@@ -137,11 +136,12 @@ TEST(RendererTest, FrontPlaneOccludesBackPlane) {
       MakePlane(Vector3d(-0.5, -0.5, 0), Vector3d::UnitX(), Vector3d::UnitY(),
                 ppm, 200, 200, [](double, double) { return 60.0; });
   const TexturedPlane front =
-      MakePlane(Vector3d(-0.1, -0.1, 0.1), Vector3d::UnitX(), Vector3d::UnitY(),
-                ppm, 40, 40, [](double, double) { return 200.0; });
+      MakePlane(Vector3d(-0.1, -0.1, 0.1), Vector3d::UnitX(),
+                Vector3d::UnitY(), ppm, 40, 40,
+                [](double, double) { return 200.0; });
   const Camera cam = TestCamera().Scaled(160, 120);
-  const Rigid3d pose =
-      LookAt(Vector3d(0.05, 0.03, 0.6), Vector3d(0, 0, 0), Vector3d::UnitY());
+  const Rigid3d pose = LookAt(Vector3d(0.05, 0.03, 0.6), Vector3d(0, 0, 0),
+                              Vector3d::UnitY());
   // The result must not depend on the drawing order.
   for (const bool front_first : {false, true}) {
     const Renderer renderer(front_first ? std::vector{front, back}
@@ -161,14 +161,14 @@ TEST(RendererTest, FrontPlaneOccludesBackPlane) {
         if (std::abs(xf.x()) < 0.1 - m && std::abs(xf.y()) < 0.1 - m) {
           ++front_pixels;
           wrong += std::abs(grey.at<uint8_t>(v, u) - 200) > 1;
-          max_rel_depth = std::max(max_rel_depth,
-                                   std::abs(depth.at<float>(v, u) - zf) / zf);
+          max_rel_depth = std::max(
+              max_rel_depth, std::abs(depth.at<float>(v, u) - zf) / zf);
         } else if ((std::abs(xf.x()) > 0.1 + m || std::abs(xf.y()) > 0.1 + m) &&
                    std::abs(xb.x()) < 0.5 - m && std::abs(xb.y()) < 0.5 - m) {
           ++back_pixels;
           wrong += std::abs(grey.at<uint8_t>(v, u) - 60) > 1;
-          max_rel_depth = std::max(max_rel_depth,
-                                   std::abs(depth.at<float>(v, u) - zb) / zb);
+          max_rel_depth = std::max(
+              max_rel_depth, std::abs(depth.at<float>(v, u) - zb) / zb);
         }
       }
     }
@@ -197,8 +197,8 @@ TEST(RendererTest, PolygonAndUnseenTexelsShowBackground) {
   options.background_grey = 0;
   const Renderer renderer({plane}, options);
   const Camera cam = TestCamera().Scaled(160, 120);
-  const Rigid3d pose =
-      LookAt(Vector3d(0.02, -0.03, 0.9), Vector3d(0, 0, 0), Vector3d::UnitY());
+  const Rigid3d pose = LookAt(Vector3d(0.02, -0.03, 0.9), Vector3d(0, 0, 0),
+                              Vector3d::UnitY());
   cv::Mat grey;
   renderer.Render(cam, pose, &grey);
   int inside = 0, outside = 0, wrong = 0;
@@ -208,8 +208,10 @@ TEST(RendererTest, PolygonAndUnseenTexelsShowBackground) {
       double z = 0;
       CastToHorizontalPlane(cam, pose, u, v, 0.0, &x, &z);
       const double s = x.x() + 0.5, t = x.y() + 0.5, m = 0.02;
-      const bool in = s > 0.5 + m && s < 0.95 - m && t > 0.05 + m && t < s - m;
-      const bool out = s < 0.5 - m || s > 0.95 + m || t < 0.05 - m || t > s + m;
+      const bool in = s > 0.5 + m && s < 0.95 - m && t > 0.05 + m &&
+                      t < s - m;
+      const bool out = s < 0.5 - m || s > 0.95 + m || t < 0.05 - m ||
+                       t > s + m;
       if (in) {
         ++inside;
         wrong += std::abs(grey.at<uint8_t>(v, u) - 50) > 1;
@@ -225,8 +227,8 @@ TEST(RendererTest, PolygonAndUnseenTexelsShowBackground) {
 
   // From far away the coarse mip levels mix seen and unseen texels: thanks
   // to premultiplied alpha the result stays 50, never drifts to white.
-  const Rigid3d far_pose =
-      LookAt(Vector3d(0.1, 0.1, 12), Vector3d(0, 0, 0), Vector3d::UnitY());
+  const Rigid3d far_pose = LookAt(Vector3d(0.1, 0.1, 12), Vector3d(0, 0, 0),
+                                  Vector3d::UnitY());
   const RenderStats stats = renderer.Render(cam, far_pose, &grey);
   ASSERT_GT(stats.pixels_foreground, 5);
   for (int v = 0; v < cam.height; ++v) {
@@ -257,13 +259,13 @@ double ForegroundVariance(const cv::Mat& grey, const cv::Mat& depth,
 
 TEST(RendererTest, MipmapsRemoveAliasingOfMinifiedCheckerboard) {
   const double ppm = 1000;  // 2-texel squares: 2 mm
-  const TexturedPlane plane =
-      MakePlane(Vector3d(0, 0, 0), Vector3d::UnitX(), Vector3d::UnitY(), ppm,
-                512, 512, [](double s, double t) {
-                  const int a = static_cast<int>(std::floor(s * 500));
-                  const int b = static_cast<int>(std::floor(t * 500));
-                  return ((a + b) % 2) ? 255.0 : 0.0;
-                });
+  const TexturedPlane plane = MakePlane(
+      Vector3d(0, 0, 0), Vector3d::UnitX(), Vector3d::UnitY(), ppm, 512, 512,
+      [](double s, double t) {
+        const int a = static_cast<int>(std::floor(s * 500));
+        const int b = static_cast<int>(std::floor(t * 500));
+        return ((a + b) % 2) ? 255.0 : 0.0;
+      });
   const Camera cam = TestCamera().Scaled(160, 120);
   const Rigid3d pose = LookAt(Vector3d(0.55, 0.2, 1.5),
                               Vector3d(0.256, 0.256, 0), Vector3d::UnitY());
@@ -280,8 +282,8 @@ TEST(RendererTest, MipmapsRemoveAliasingOfMinifiedCheckerboard) {
               var_plain, n_mip);
   ASSERT_GT(n_mip, 1000);
   EXPECT_NEAR(n_mip, n_plain, 0.02 * n_mip);
-  EXPECT_LT(var_mip, 30.0);      // std < 5.5 grey levels
-  EXPECT_GT(var_plain, 2000.0);  // aliasing: std > 45 grey levels
+  EXPECT_LT(var_mip, 30.0);       // std < 5.5 grey levels
+  EXPECT_GT(var_plain, 2000.0);   // aliasing: std > 45 grey levels
   EXPECT_GT(var_plain / (var_mip + 1.0), 50.0);
 }
 
@@ -465,9 +467,9 @@ TEST(RendererTest, ColorRenderMatchesTexture) {
             1);
   renderer.Render(cam, pose, &grey);
   // 0.114 B + 0.587 G + 0.299 R = 139.6
-  EXPECT_LE(
-      cv::norm(grey, cv::Mat(60, 80, CV_8UC1, cv::Scalar(140)), cv::NORM_INF),
-      1);
+  EXPECT_LE(cv::norm(grey, cv::Mat(60, 80, CV_8UC1, cv::Scalar(140)),
+                     cv::NORM_INF),
+            1);
   // Colour needs enable_color.
   EXPECT_THROW(Renderer({plane}).RenderColor(cam, pose, &bgr), OptionsError);
 }
