@@ -65,7 +65,9 @@ BENCHMARK(BM_TriangulateTracks)
 void BM_BundleAdjust(benchmark::State& state) {
   const Problem& p = GetProblem();
   BundleAdjustmentOptions options;
+  // 0: the direct Schur solver, 1: preconditioned CG (no automatic choice).
   options.iterative_schur = state.range(0) != 0;
+  options.iterative_schur_min_covisibility = 0.0;
   options.verbose = std::getenv("MONOMAP_BA_VERBOSE") != nullptr;
   BundleAdjustmentReport report;
   for (auto _ : state) {
@@ -109,7 +111,8 @@ void BM_BundleAdjust(benchmark::State& state) {
   state.counters["iterations"] = report.iterations;
   state.counters["rms_before_px"] = report.initial_rms_error_px;
   state.counters["rms_after_px"] = report.final_rms_error_px;
-  state.SetLabel(report.termination);
+  state.counters["covisibility"] = report.covisibility;
+  state.SetLabel(report.linear_solver + " " + report.termination);
 }
 BENCHMARK(BM_BundleAdjust)
     ->Arg(0)

@@ -286,6 +286,8 @@ nlohmann::json MappingReport::ToJson() const {
       {"final_median_reprojection_error_px",
        bundle_adjustment.final_median_error_px},
       {"iterations", bundle_adjustment.iterations},
+      {"covisibility", bundle_adjustment.covisibility},
+      {"linear_solver", bundle_adjustment.linear_solver},
       {"points_dropped", bundle_adjustment.num_dropped},
       {"mean_pose_change_m", bundle_adjustment.mean_pose_change_m},
       {"mean_pose_change_deg", bundle_adjustment.mean_pose_change_deg}};

@@ -305,6 +305,7 @@ BundleAdjustmentReport BundleAdjust(const Camera& camera,
   const std::vector<char> joint =
       SelectJointPoints(landmark_tracks, options.max_points);
   std::vector<bool> observed(num_frames, false);
+  int64_t sum_squared_track_length = 0;
   for (size_t i = 0; i < points.size(); ++i) {
     if (!joint[i]) continue;
     // A point behind one of its cameras has no valid residual (Ceres would
@@ -315,6 +316,9 @@ BundleAdjustmentReport BundleAdjust(const Camera& camera,
                  DepthInCamera(cams_from_world[obs.frame], points[i]) > 1e-6;
     }
     if (!in_front) continue;
+    const int64_t k =
+        static_cast<int64_t>(landmark_tracks[i]->observations.size());
+    sum_squared_track_length += k * k;
     for (const Observation& obs : landmark_tracks[i]->observations) {
       PoseParams& p = poses[obs.frame];
       problem.AddResidualBlock(ReprojectionCost::Create(intrinsics, obs.px),
@@ -392,13 +396,21 @@ BundleAdjustmentReport BundleAdjust(const Camera& camera,
   for (int i = first; i <= last; ++i) {
     num_pose_blocks += problem.HasParameterBlock(poses[i].v) ? 1 : 0;
   }
+  report.covisibility = report.num_residuals > 0
+                            ? static_cast<double>(sum_squared_track_length) /
+                                  report.num_residuals
+                            : 0.0;
+  const bool iterative =
+      options.iterative_schur ||
+      (options.iterative_schur_min_covisibility > 0.0 &&
+       report.covisibility > options.iterative_schur_min_covisibility);
   solver_options.linear_solver_type =
-      options.iterative_schur ? ceres::ITERATIVE_SCHUR
+      iterative ? ceres::ITERATIVE_SCHUR
       : num_pose_blocks <= options.dense_schur_max_poses ? ceres::DENSE_SCHUR
                                                          : ceres::SPARSE_SCHUR;
-  if (options.iterative_schur) {
-    solver_options.preconditioner_type = ceres::SCHUR_JACOBI;
-  }
+  if (iterative) solver_options.preconditioner_type = ceres::SCHUR_JACOBI;
+  report.linear_solver =
+      ceres::LinearSolverTypeToString(solver_options.linear_solver_type);
   solver_options.linear_solver_ordering = ordering;
   // Odometry is a good start, so begin close to Gauss-Newton: the strong
   // default damping stalls the weakly constrained directions (scale, which

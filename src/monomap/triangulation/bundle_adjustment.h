@@ -64,9 +64,17 @@ struct BundleAdjustmentOptions {
   // span tens of frames), so its cost grows linearly with the sequence,
   // the dense one's cubically.
   int dense_schur_max_poses = 150;
-  // Use ITERATIVE_SCHUR (preconditioned CG) instead of SPARSE_SCHUR: for
-  // very long sequences where the reduced camera system gets large.
+  // Always use ITERATIVE_SCHUR (preconditioned CG): for very long
+  // sequences where the reduced camera system gets large.
   bool iterative_schur = false;
+  // ... and use it anyway when the adjusted points are seen by more than
+  // this many frames on average over their observations (sum k^2 / sum k
+  // for points seen k times): forming the Schur complement costs a 6x6
+  // block product per pair of observations of a point, a CG iteration one
+  // per observation. Desk (101 keyframes, 65): linear solver 0.95 ->
+  // 0.41 s, final cost equal to 6 digits; simulated hallway (68 keyframes,
+  // 30): dense is as fast or faster (0.32 vs 0.44 s). <= 0: never.
+  double iterative_schur_min_covisibility = 40.0;
   // After adjustment, landmarks whose mean reprojection error (raw px)
   // exceeds this are dropped (same meaning and default as
   // TriangulationOptions::max_reprojection_error_px).
@@ -91,6 +99,10 @@ struct BundleAdjustmentReport {
   double initial_median_error_px = 0.0;
   double final_median_error_px = 0.0;
   int iterations = 0;
+  // Mean number of frames seeing a joint point, over its observations
+  // (sum k^2 / sum k), and the linear solver it chose.
+  double covisibility = 0.0;
+  std::string linear_solver;
   std::string termination;          // Ceres termination type, "disabled" if off
   int num_dropped = 0;              // landmarks dropped after adjustment
   double mean_pose_change_m = 0.0;  // mean camera centre displacement

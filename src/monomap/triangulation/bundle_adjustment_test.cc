@@ -119,6 +119,60 @@ TEST(BundleAdjustmentTest, CorrectsOdometryDrift) {
   EXPECT_LT(after.mean_rotation_deg, before.mean_rotation_deg / 2.0);
 }
 
+// The automatic choice of the linear solver (iterative for points seen by
+// many frames) must not change the solution: preconditioned CG solves each
+// step only approximately, but LM converges to the same minimum.
+TEST(BundleAdjustmentTest, IterativeSchurReachesTheDirectSolution) {
+  SyntheticSceneOptions scene_options;
+  scene_options.num_tracks = 300;
+  scene_options.pixel_noise_px = 0.3;
+  scene_options.seed = 5;
+  const SyntheticScene scene = MakeSyntheticScene(scene_options);
+  const std::vector<Rigid3d> odometry =
+      SimulateOdometryDrift(scene.world_from_cam, OdometryDriftOptions());
+  std::vector<Landmark> triangulated;
+  TriangulateTracks(scene.camera, odometry, scene.tracks,
+                    TriangulationOptions(), &triangulated);
+
+  auto run = [&](double min_covisibility, std::vector<Rigid3d>* poses,
+                 std::vector<Landmark>* landmarks) {
+    *poses = odometry;
+    *landmarks = triangulated;
+    BundleAdjustmentOptions options;
+    options.iterative_schur_min_covisibility = min_covisibility;
+    return BundleAdjust(scene.camera, scene.tracks, options, poses, landmarks);
+  };
+  std::vector<Rigid3d> direct_poses, cg_poses;
+  std::vector<Landmark> direct_points, cg_points;
+  const BundleAdjustmentReport direct =
+      run(0.0, &direct_poses, &direct_points);
+  // Below the scene's covisibility: the automatic choice takes CG.
+  const BundleAdjustmentReport cg =
+      run(0.5 * direct.covisibility, &cg_poses, &cg_points);
+  EXPECT_GT(direct.covisibility, 2.0);
+  EXPECT_EQ(direct.linear_solver, "DENSE_SCHUR");
+  EXPECT_EQ(cg.linear_solver, "ITERATIVE_SCHUR");
+  EXPECT_EQ(cg.covisibility, direct.covisibility);
+  EXPECT_NEAR(cg.final_rms_error_px, direct.final_rms_error_px, 1e-3);
+  ASSERT_EQ(cg_points.size(), direct_points.size());
+  double max_pose_diff = 0.0, max_point_diff = 0.0;
+  for (size_t i = 0; i < cg_poses.size(); ++i) {
+    max_pose_diff = std::max(
+        max_pose_diff,
+        (cg_poses[i].translation - direct_poses[i].translation).norm());
+  }
+  for (size_t i = 0; i < cg_points.size(); ++i) {
+    max_point_diff = std::max(
+        max_point_diff,
+        (cg_points[i].x_in_world - direct_points[i].x_in_world).norm());
+  }
+  // Both solutions are ~1 mm from the truth; Ceres stops both within its
+  // function tolerance of the minimum, where they agree to ~10 um (poses)
+  // and ~60 um (the worst point).
+  EXPECT_LT(max_pose_diff, 5e-5);
+  EXPECT_LT(max_point_diff, 2e-4);
+}
+
 TEST(BundleAdjustmentTest, DisabledLeavesInputUnchanged) {
   SyntheticSceneOptions scene_options;
   scene_options.num_tracks = 100;
