@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <map>
 #include <memory>
+#include <mutex>
 
 #include <benchmark/benchmark.h>
 
@@ -25,6 +26,7 @@ struct BenchScene {
   std::vector<testing::ScenePlane> planes;
   std::unique_ptr<testing::RayCaster> caster;
   std::map<int, cv::Mat> images;  // rendered on first use
+  std::mutex images_mutex;
 
   BenchScene() {
     camera.width = 752;
@@ -57,7 +59,9 @@ struct BenchScene {
     caster = std::make_unique<testing::RayCaster>(camera, 1);
   }
 
+  // Rendered on first use; the mosaic calls this from several threads.
   cv::Mat Image(int f) {
+    const std::lock_guard<std::mutex> lock(images_mutex);
     auto it = images.find(f);
     if (it == images.end()) {
       it = images

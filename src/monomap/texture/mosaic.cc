@@ -419,11 +419,21 @@ MosaicReport BuildTexturedPlanes(
     for (auto it = cache.begin(); it != cache.end();) {
       it = needed.count(it->first) ? std::next(it) : cache.erase(it);
     }
+    // Decoding dominates the loading (desk: ~80 JPEGs, 0.3 s on one core):
+    // load in parallel. The loader reads files and keeps no state.
+    std::vector<int> missing;
+    for (const auto* h : selected[p]) {
+      if (!cache.count(h->frame)) missing.push_back(h->frame);
+    }
+    std::vector<cv::Mat> loaded(missing.size());
+    tbb::parallel_for(size_t{0}, missing.size(), [&](size_t i) {
+      loaded[i] = ToBgr(load_image(missing[i]), missing[i], camera);
+    });
+    for (size_t i = 0; i < missing.size(); ++i) {
+      cache[missing[i]] = std::move(loaded[i]);
+    }
     std::vector<FrameContext> frames;
     for (const auto* h : selected[p]) {
-      if (!cache.count(h->frame)) {
-        cache[h->frame] = ToBgr(load_image(h->frame), h->frame, camera);
-      }
       FrameContext fc;
       fc.frame = h->frame;
       fc.image = &cache[h->frame];

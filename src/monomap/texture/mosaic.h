@@ -80,7 +80,8 @@ struct MosaicReport {
   double seconds = 0.0;
 };
 
-// Loads the raw (distorted) image of a frame: 8-bit grey or BGR.
+// Loads the raw (distorted) image of a frame: 8-bit grey or BGR. Called
+// from several threads at once (images are decoded in parallel).
 using ImageLoader = std::function<cv::Mat(int frame)>;
 
 // Builds one TexturedPlane per segment that some frame sees (same id,
