@@ -45,10 +45,16 @@ CheckerboardAccuracy EvaluateCheckerboard(const Map& map,
     if (plane.texture.empty()) continue;
     const cv::Mat grey = GreyOnWhite(plane.texture);
     std::vector<cv::Point2f> corners;
+    std::string detector = "findChessboardCorners";
     if (!cv::findChessboardCorners(
             grey, pattern, corners,
             cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE)) {
-      continue;
+      detector = "findChessboardCornersSB";
+      corners.clear();
+      if (!cv::findChessboardCornersSB(grey, pattern, corners,
+                                       cv::CALIB_CB_ACCURACY)) {
+        continue;
+      }
     }
     cv::cornerSubPix(
         grey, corners, cv::Size(5, 5), cv::Size(-1, -1),
@@ -86,6 +92,7 @@ CheckerboardAccuracy EvaluateCheckerboard(const Map& map,
     result.found = true;
     result.plane_id = plane.id;
     result.corners_found = static_cast<int>(mapped.size());
+    result.detector = detector;
     result.error_m = best;
     result.corners_in_world = mapped;
     return result;

@@ -3,6 +3,7 @@
 // the map format, and compare with their true positions.
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -30,15 +31,22 @@ struct CheckerboardAccuracy {
   bool found = false;
   int plane_id = -1;
   int corners_found = 0;
+  // The OpenCV detector that found them: "findChessboardCorners" or, where
+  // that one fails, "findChessboardCornersSB".
+  std::string detector;
   // Distances between the mapped texture corners and the true corners (m).
   ErrorStats error_m;
   // Mapped corner positions in world coordinates, in the spec's order.
   std::vector<Eigen::Vector3d> corners_in_world;
 };
 
-// Searches every plane texture for the board (cv::findChessboardCorners +
-// cornerSubPix) and returns the first plane where all inner corners are
-// found. The detection's ordering ambiguity (start corner, mirroring) is
+// Searches every plane texture for the board (cv::findChessboardCorners,
+// else the sector-based cv::findChessboardCornersSB, then cornerSubPix) and
+// returns the first plane where all inner corners are found. The classic
+// detector needs a quiet zone around the board and loses it where the
+// plane's extent runs close to the outer squares; the sector-based one
+// does not (on the desk texture either one was the sole finder in some
+// builds). The detection's ordering ambiguity (start corner, mirroring) is
 // resolved by taking the ordering with the smallest error.
 CheckerboardAccuracy EvaluateCheckerboard(const Map& map,
                                           const CheckerboardSpec& spec);

@@ -48,6 +48,7 @@ TEST(Checkerboard, MapsCornersToTheirWorldPositions) {
     map.planes.push_back(BoardPlane(flip, 0.0));
     const CheckerboardAccuracy acc = EvaluateCheckerboard(map, spec);
     ASSERT_TRUE(acc.found) << "flip " << flip;
+    EXPECT_EQ(acc.detector, "findChessboardCorners");
     EXPECT_EQ(acc.corners_found, 54);
     // Exact drawing at 1 mm per texel: sub-texel corners.
     EXPECT_LT(acc.error_m.mean, 0.0005) << flip;
@@ -60,6 +61,27 @@ TEST(Checkerboard, MapsCornersToTheirWorldPositions) {
   const CheckerboardAccuracy acc = EvaluateCheckerboard(shifted, spec);
   ASSERT_TRUE(acc.found);
   EXPECT_NEAR(acc.error_m.mean, 0.003, 0.0006);
+}
+
+// Black surroundings right up to the board's outer squares (no quiet zone)
+// defeat the classic detector; the sector-based fallback still finds the
+// board, with the same accuracy.
+TEST(Checkerboard, FindsBoardWithoutQuietZone) {
+  CheckerboardSpec spec;
+  spec.origin = Eigen::Vector3d(0.1, 0.05, 0);
+  Map map;
+  map.planes.push_back(BoardPlane(false, 0.0));
+  cv::Mat& t = map.planes.back().texture;
+  // The board (outer squares included) spans world x 0.06-0.46, y 0.01-0.29,
+  // texels 60-460 x 10-290 at 1000 px/m.
+  cv::Mat outside(t.size(), CV_8UC1, cv::Scalar(255));
+  outside(cv::Rect(60, 10, 400, 280)).setTo(0);
+  t.setTo(cv::Scalar(0, 0, 0, 255), outside);
+  const CheckerboardAccuracy acc = EvaluateCheckerboard(map, spec);
+  ASSERT_TRUE(acc.found);
+  EXPECT_EQ(acc.detector, "findChessboardCornersSB");
+  EXPECT_EQ(acc.corners_found, 54);
+  EXPECT_LT(acc.error_m.mean, 0.0005);
 }
 
 TEST(Checkerboard, NotFoundInPlainTexture) {

@@ -208,13 +208,17 @@ void RegisterEvalCommand(CLI::App& app) {
     j["plane_id"] = acc.plane_id;
     j["corners_found"] = acc.corners_found;
     j["corners_expected"] = spec.inner_corners_x * spec.inner_corners_y;
-    if (acc.found) j["error_m"] = ToJson(acc.error_m);
-    char table[256];
+    if (acc.found) {
+      j["detector"] = acc.detector;
+      j["error_m"] = ToJson(acc.error_m);
+    }
+    char table[320];
     std::snprintf(table, sizeof(table),
-                  "checkerboard %dx%d: %s in plane %d, corner error mean "
+                  "checkerboard %dx%d: %s in plane %d%s%s, corner error mean "
                   "%.2f mm, median %.2f mm, max %.2f mm\n",
                   spec.inner_corners_x, spec.inner_corners_y,
                   acc.found ? "found" : "NOT found", acc.plane_id,
+                  acc.found ? " by " : "", acc.detector.c_str(),
                   acc.error_m.mean * 1e3, acc.error_m.median * 1e3,
                   acc.error_m.max * 1e3);
     PrintOrWrite(j, table, ba->json);
