@@ -231,6 +231,8 @@ void BundleAdjustmentOptions::Check() const {
   CheckOption(num_threads >= 1, "num_threads", "must be >= 1");
   CheckOption(dense_schur_max_poses >= 0, "dense_schur_max_poses",
               "must be >= 0");
+  CheckOption(iterative_schur_eta > 0 && iterative_schur_eta < 1,
+              "iterative_schur_eta", "must be in (0, 1)");
   CheckOption(max_reprojection_error_px > 0, "max_reprojection_error_px",
               "must be positive");
   CheckOption(min_depth_m > 0, "min_depth_m", "must be positive");
@@ -400,15 +402,20 @@ BundleAdjustmentReport BundleAdjust(const Camera& camera,
                             ? static_cast<double>(sum_squared_track_length) /
                                   report.num_residuals
                             : 0.0;
+  // CG instead of the dense solver only: the sparse one is fast on its own.
+  const bool dense = num_pose_blocks <= options.dense_schur_max_poses;
   const bool iterative =
       options.iterative_schur ||
-      (options.iterative_schur_min_covisibility > 0.0 &&
+      (dense && options.iterative_schur_min_covisibility > 0.0 &&
        report.covisibility > options.iterative_schur_min_covisibility);
   solver_options.linear_solver_type =
       iterative ? ceres::ITERATIVE_SCHUR
-      : num_pose_blocks <= options.dense_schur_max_poses ? ceres::DENSE_SCHUR
-                                                         : ceres::SPARSE_SCHUR;
-  if (iterative) solver_options.preconditioner_type = ceres::SCHUR_JACOBI;
+      : dense   ? ceres::DENSE_SCHUR
+                : ceres::SPARSE_SCHUR;
+  if (iterative) {
+    solver_options.preconditioner_type = ceres::SCHUR_JACOBI;
+    solver_options.eta = options.iterative_schur_eta;
+  }
   report.linear_solver =
       ceres::LinearSolverTypeToString(solver_options.linear_solver_type);
   solver_options.linear_solver_ordering = ordering;

@@ -166,11 +166,12 @@ TEST(BundleAdjustmentTest, IterativeSchurReachesTheDirectSolution) {
         max_point_diff,
         (cg_points[i].x_in_world - direct_points[i].x_in_world).norm());
   }
-  // Both solutions are ~1 mm from the truth; Ceres stops both within its
-  // function tolerance of the minimum, where they agree to ~10 um (poses)
-  // and ~60 um (the worst point).
-  EXPECT_LT(max_pose_diff, 5e-5);
-  EXPECT_LT(max_point_diff, 2e-4);
+  // Both solutions are ~1 mm from the truth and stop within Ceres'
+  // function tolerance of the minimum, where they agree to ~1 um (poses)
+  // and ~30 um (the worst point). With Ceres' default CG tolerance (eta
+  // 0.1) the poses differed by 11 um.
+  EXPECT_LT(max_pose_diff, 5e-6);
+  EXPECT_LT(max_point_diff, 1e-4);
 }
 
 TEST(BundleAdjustmentTest, DisabledLeavesInputUnchanged) {
