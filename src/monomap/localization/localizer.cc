@@ -45,6 +45,8 @@ void LocalizerOptions::Check() const {
   refine_mcc.Check();
   renderer.Check();
   CheckOption(mcc_top_k >= 0, "mcc_top_k", "must be >= 0");
+  CheckOption(mcc_spread_m >= 0, "mcc_spread_m", "must be >= 0");
+  CheckOption(mcc_spread_deg >= 0, "mcc_spread_deg", "must be >= 0");
   CheckOption(merge_translation_m >= 0, "merge_translation_m", "must be >= 0");
   CheckOption(merge_rotation_deg >= 0, "merge_rotation_deg", "must be >= 0");
   CheckOption(resample_ess_fraction > 0 && resample_ess_fraction <= 1,
@@ -265,14 +267,10 @@ LocalizerEstimate Localizer::Step(const cv::Mat& live_image_raw,
   // sees their corrected weights).
   if (options_.method == LocalizationMethod::kMcc && options_.mcc_top_k > 0) {
     const Timer mcc_timer;
-    std::vector<size_t> order(particles_.size());
-    std::iota(order.begin(), order.end(), 0);
-    const size_t k = std::min<size_t>(options_.mcc_top_k, order.size());
-    std::partial_sort(order.begin(), order.begin() + k, order.end(),
-                      [&](size_t a, size_t b) {
-                        return particles_[a].log_weight >
-                               particles_[b].log_weight;
-                      });
+    const std::vector<size_t> order = SpreadHeaviest(
+        particles_, static_cast<size_t>(options_.mcc_top_k),
+        options_.mcc_spread_m, options_.mcc_spread_deg * kDegToRad);
+    const size_t k = order.size();
     const cv::Mat live_mid = LiveImagePreparer::Downscale(
         undistorted, options_.mcc.width, options_.mcc.height);
     std::vector<int> accepted(k, 0);

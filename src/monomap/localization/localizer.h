@@ -52,6 +52,13 @@ struct LocalizerOptions {
   // while the particles are spread (global start: room seed 5 localized
   // with 64, lost with 8); once they have merged into a few, all are.
   int mcc_top_k = 64;
+  // MCC: those particles are picked heaviest first but at least this far
+  // apart (m, or deg of heading/rotation), so that a crowd of particles in
+  // one wrong mode does not take every correction while a lighter
+  // particle in the true pose's basin gets none. When too few are that
+  // far apart, the heaviest of the rest fill up. 0: plain top k.
+  double mcc_spread_m = 0.1;
+  double mcc_spread_deg = 10.0;
   // MCC: the estimate of each update is corrected once more against a
   // render of refine_mcc's (larger) size; only the output changes, not the
   // particles. The particle corrections run small for speed, and at

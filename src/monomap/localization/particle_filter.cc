@@ -239,6 +239,45 @@ std::vector<int> KldResample(const std::vector<Particle>& particles,
   return out;
 }
 
+std::vector<size_t> SpreadHeaviest(const std::vector<Particle>& particles,
+                                   size_t k, double min_distance_m,
+                                   double min_angle_rad) {
+  std::vector<size_t> order(particles.size());
+  std::iota(order.begin(), order.end(), 0);
+  // Stable, so that equal weights keep the particle order (determinism).
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+    return particles[a].log_weight > particles[b].log_weight;
+  });
+  k = std::min(k, order.size());
+  if (min_distance_m <= 0.0 && min_angle_rad <= 0.0) {
+    order.resize(k);
+    return order;
+  }
+  std::vector<size_t> picked;
+  std::vector<char> taken(order.size(), 0);
+  picked.reserve(k);
+  for (size_t r = 0; r < order.size() && picked.size() < k; ++r) {
+    const Rigid3d& p = particles[order[r]].world_from_cam;
+    bool apart = true;
+    for (size_t q : picked) {
+      const Rigid3d& o = particles[q].world_from_cam;
+      if ((p.translation - o.translation).norm() < min_distance_m &&
+          AngleBetween(p.rotation, o.rotation) < min_angle_rad) {
+        apart = false;
+        break;
+      }
+    }
+    if (apart) {
+      picked.push_back(order[r]);
+      taken[r] = 1;
+    }
+  }
+  for (size_t r = 0; r < order.size() && picked.size() < k; ++r) {
+    if (!taken[r]) picked.push_back(order[r]);
+  }
+  return picked;
+}
+
 int MergeDuplicateParticles(std::vector<Particle>* particles,
                             double max_translation_m,
                             double max_rotation_rad) {

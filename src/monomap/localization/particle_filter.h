@@ -141,6 +141,14 @@ int MergeDuplicateParticles(std::vector<Particle>* particles,
                             double max_translation_m,
                             double max_rotation_rad);
 
+// Indices of up to k particles, heaviest first, each at least min_distance_m
+// or min_angle_rad away from every one picked before it (a greedy
+// non-maximum suppression over poses); if fewer than k are that far apart,
+// the heaviest of the others fill up. With both limits 0: the k heaviest.
+std::vector<size_t> SpreadHeaviest(const std::vector<Particle>& particles,
+                                   size_t k, double min_distance_m,
+                                   double min_angle_rad);
+
 // Weighted mean of poses: translation averaged, rotation by the
 // eigenvector of sum w q q^T (Markley et al. 2007), which is insensitive
 // to the sign of q. Weights need not be normalized.

@@ -228,6 +228,33 @@ TEST(Particles, MergeDuplicatesAddsWeights) {
   EXPECT_NEAR(w[2], 0.2, 1e-9);
 }
 
+TEST(Particles, SpreadHeaviestSkipsTheCrowd) {
+  // Six heavy particles within 5 cm (one mode), and lighter ones elsewhere:
+  // 0.5 m away, at the crowd's position but turned 30 degrees, 1 m away.
+  std::vector<Particle> ps(9);
+  for (int i = 0; i < 6; ++i) {
+    ps[i].world_from_cam.translation = {0.01 * i, 0, 0};
+    ps[i].log_weight = -0.1 * i;
+  }
+  ps[6].world_from_cam.translation = {0.5, 0, 0};
+  ps[6].log_weight = -2.0;
+  ps[7].world_from_cam.translation = {0.01, 0, 0};
+  ps[7].world_from_cam.rotation =
+      QuaternionFromRotationVector({0, 0, 30 * M_PI / 180});
+  ps[7].log_weight = -3.0;
+  ps[8].world_from_cam.translation = {1.0, 0, 0};
+  ps[8].log_weight = -4.0;
+  const double ten_deg = 10 * M_PI / 180;
+  EXPECT_EQ(SpreadHeaviest(ps, 3, 0.1, ten_deg),
+            (std::vector<size_t>{0, 6, 7}));
+  // Only four are apart: the crowd's next heaviest fill up.
+  EXPECT_EQ(SpreadHeaviest(ps, 6, 0.1, ten_deg),
+            (std::vector<size_t>{0, 6, 7, 8, 1, 2}));
+  // No spread: the plain top k.
+  EXPECT_EQ(SpreadHeaviest(ps, 3, 0.0, 0.0), (std::vector<size_t>{0, 1, 2}));
+  EXPECT_EQ(SpreadHeaviest(ps, 20, 0.1, ten_deg).size(), 9u);
+}
+
 TEST(Particles, WeightedMeanPoseIgnoresQuaternionSign) {
   std::vector<Rigid3d> poses = {
       Rigid3d(QuaternionFromRotationVector({0, 0, 0.1}), {1, 0, 0}),
