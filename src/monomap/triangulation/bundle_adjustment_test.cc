@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 
 #include <gtest/gtest.h>
 
@@ -62,12 +63,17 @@ Errors Compare(const SyntheticScene& scene,
   return e;
 }
 
+// A synthetic scene whose tracks carry 0.3 px of pixel noise.
+SyntheticScene NoisyScene(int num_tracks, uint64_t seed) {
+  SyntheticSceneOptions options;
+  options.num_tracks = num_tracks;
+  options.pixel_noise_px = 0.3;
+  options.seed = seed;
+  return MakeSyntheticScene(options);
+}
+
 TEST(BundleAdjustmentTest, CorrectsOdometryDrift) {
-  SyntheticSceneOptions scene_options;
-  scene_options.num_tracks = 400;
-  scene_options.pixel_noise_px = 0.3;
-  scene_options.seed = 11;
-  const SyntheticScene scene = MakeSyntheticScene(scene_options);
+  const SyntheticScene scene = NoisyScene(400, 11);
   std::vector<Rigid3d> poses =
       SimulateOdometryDrift(scene.world_from_cam, OdometryDriftOptions());
 
@@ -123,11 +129,7 @@ TEST(BundleAdjustmentTest, CorrectsOdometryDrift) {
 // many frames) must not change the solution: preconditioned CG solves each
 // step only approximately, but LM converges to the same minimum.
 TEST(BundleAdjustmentTest, IterativeSchurReachesTheDirectSolution) {
-  SyntheticSceneOptions scene_options;
-  scene_options.num_tracks = 300;
-  scene_options.pixel_noise_px = 0.3;
-  scene_options.seed = 5;
-  const SyntheticScene scene = MakeSyntheticScene(scene_options);
+  const SyntheticScene scene = NoisyScene(300, 5);
   const std::vector<Rigid3d> odometry =
       SimulateOdometryDrift(scene.world_from_cam, OdometryDriftOptions());
   std::vector<Landmark> triangulated;
@@ -175,10 +177,7 @@ TEST(BundleAdjustmentTest, IterativeSchurReachesTheDirectSolution) {
 }
 
 TEST(BundleAdjustmentTest, DisabledLeavesInputUnchanged) {
-  SyntheticSceneOptions scene_options;
-  scene_options.num_tracks = 100;
-  scene_options.pixel_noise_px = 0.3;
-  const SyntheticScene scene = MakeSyntheticScene(scene_options);
+  const SyntheticScene scene = NoisyScene(100, SyntheticSceneOptions().seed);
   std::vector<Rigid3d> poses =
       SimulateOdometryDrift(scene.world_from_cam, OdometryDriftOptions());
   std::vector<Landmark> landmarks;
