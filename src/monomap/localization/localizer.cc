@@ -53,6 +53,7 @@ void LocalizerOptions::Check() const {
               "resample_ess_fraction", "must be in (0, 1]");
   CheckOption(injection_fraction >= 0 && injection_fraction < 1,
               "injection_fraction", "must be in [0, 1)");
+  CheckOption(mcc_min_injected >= 0, "mcc_min_injected", "must be >= 0");
   CheckOption(alpha_slow >= 0 && alpha_slow <= 1, "alpha_slow",
               "must be in [0, 1]");
   CheckOption(alpha_fast >= 0 && alpha_fast <= 1, "alpha_fast",
@@ -366,7 +367,14 @@ LocalizerEstimate Localizer::Step(const cv::Mat& live_image_raw,
       next.push_back(particles_[i]);
       next.back().log_weight = 0.0;
     }
-    const int n_inject = static_cast<int>(std::lround(injection * next.size()));
+    int n_inject = static_cast<int>(std::lround(injection * next.size()));
+    if (options_.method == LocalizationMethod::kMcc) {
+      // Never more than half the set: the resampled particles carry the
+      // filter's belief.
+      n_inject = std::max(
+          n_inject, std::min(options_.mcc_min_injected,
+                             static_cast<int>(next.size()) / 2));
+    }
     std::uniform_int_distribution<size_t> pick(0, next.size() - 1);
     for (int i = 0; i < n_inject; ++i) next[pick(rng_)] = RandomParticle();
     stats.injected = n_inject;

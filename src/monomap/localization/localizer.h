@@ -85,6 +85,12 @@ struct LocalizerOptions {
   // Fraction of each resampled set replaced by particles drawn over the
   // whole area, so the filter recovers when kidnapped.
   double injection_fraction = 0.02;
+  // MCC: at least this many injected per resampling. MCC merges the set
+  // down to a handful of hypotheses (a KLD minimum of 100 mostly
+  // duplicates), so the fraction injects ~2; every injected particle is
+  // corrected, and one that lands in MCC's ~20 cm basin of the true pose
+  // recovers the filter from a wrong mode.
+  int mcc_min_injected = 8;
   // Augmented MCL (Thrun et al. 8.3.5): if alpha_fast > alpha_slow > 0,
   // injection uses max(injection_fraction, 1 - w_fast / w_slow) capped at
   // max_injection_fraction.
