@@ -65,6 +65,9 @@ struct SweepOptions {
   // bit-reproducible (the map then differs in the last digits from run to
   // run, which is enough to flip some global-localization outcomes).
   int ba_threads = 1;
+  // MCC: least random particles injected per resampling (-1: the
+  // localizer's default).
+  int mcc_min_injected = -1;
   LocalizationAccuracyOptions accuracy;
   std::string out = "localization_sweep.json";
   std::string keep_dir;
@@ -208,6 +211,7 @@ nlohmann::json RunSeed(const SweepOptions& o, const std::string& world,
     lo.kld.max_particles = configs[c].particles;
     lo.kld.min_particles = std::min(lo.kld.min_particles, lo.num_particles);
     lo.seed = static_cast<uint64_t>(seed);
+    if (o.mcc_min_injected >= 0) lo.mcc_min_injected = o.mcc_min_injected;
     std::vector<TimedPose> trajectory;
     const LocalizationReport r = LocalizeSequence(map, live, lo, &trajectory);
     ConfigRun& run = (*runs)[c];
@@ -406,6 +410,7 @@ int Run(const SweepOptions& o) {
       {"lateral_offset_m", o.lateral_offset_m},
       {"run_seed_base", o.run_seed_base},
       {"ba_threads", o.ba_threads},
+      {"mcc_min_injected", o.mcc_min_injected},
       {"max_translation_error_m", o.accuracy.max_translation_error_m},
       {"max_rotation_error_deg", o.accuracy.max_rotation_error_deg},
       {"state", "planar"},
@@ -469,6 +474,9 @@ int main(int argc, char** argv) {
                  "Lateral offset of the localization run (m, left)");
   app.add_option("--ba-threads", o.ba_threads,
                  "Bundle adjustment threads (1: bit-reproducible maps)");
+  app.add_option("--mcc-min-injected", o.mcc_min_injected,
+                 "MCC: least random particles injected per resampling "
+                 "(-1: the localizer's default)");
   app.add_option("--max-error-m", o.accuracy.max_translation_error_m,
                  "Success threshold on the position error (m)");
   app.add_option("--max-error-deg", o.accuracy.max_rotation_error_deg,

@@ -89,8 +89,10 @@ struct LocalizerOptions {
   // down to a handful of hypotheses (a KLD minimum of 100 mostly
   // duplicates), so the fraction injects ~2; every injected particle is
   // corrected, and one that lands in MCC's ~20 cm basin of the true pose
-  // recovers the filter from a wrong mode.
-  int mcc_min_injected = 8;
+  // recovers the filter from a wrong mode. More also find wrong modes
+  // that outscore the truth: room, 20 seeds, MCC 3000 / 750 particles
+  // succeeded 20 / 15 times with ~2, 20 / 17 with 4, 18 / 19 with 8.
+  int mcc_min_injected = 4;
   // Augmented MCL (Thrun et al. 8.3.5): if alpha_fast > alpha_slow > 0,
   // injection uses max(injection_fraction, 1 - w_fast / w_slow) capped at
   // max_injection_fraction.
