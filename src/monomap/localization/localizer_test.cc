@@ -257,6 +257,41 @@ TEST_F(LocalizerTest, PlanarGlobalInitConvergesWithMcc) {
   EXPECT_GT(stats.back().merged, 100);
 }
 
+// Kidnapped robot: the filter starts sure of a pose 0.4 m and 90 degrees
+// from the truth. Without injection MCC stays lost (1.5 m off at the end);
+// with the default 4 random particles per resampling, each corrected, one
+// finds the truth (measured: at update 15 of 40, then < 1 mm).
+TEST_F(LocalizerTest, MccRecoversFromAKidnappingByInjection) {
+  const Drive drive = MakeDrive({0.4, 0.1, 0.5}, 40, 0.02, 1.0 * kDeg, 7);
+  auto run = [&](int min_injected) {
+    LocalizerOptions o;
+    o.method = LocalizationMethod::kMcc;
+    o.state = LocalizationState::kPlanar;
+    o.num_particles = 200;
+    o.kld.max_particles = 200;
+    o.kld.min_particles = 50;
+    o.init_spread_m = 0.01;
+    o.init_spread_deg = 1.0;
+    o.injection_fraction = 0.0;
+    o.mcc_min_injected = min_injected;
+    o.area_min = {0.0, -0.5};
+    o.area_max = {1.0, 0.5};
+    o.seed = 2;
+    Localizer loc(map(), camera(), o, mount());
+    loc.InitializeAtPose(WorldFromCamOfBase(
+        Compose(drive.truth[0], 0.0, 0.4, 90.0 * kDeg), mount()));
+    return Run(drive, &loc);
+  };
+  const std::vector<double> stuck = run(0);
+  const std::vector<double> recovered = run(LocalizerOptions().mcc_min_injected);
+  std::printf("kidnapped: first %.3f m; last without injection %.3f m, with "
+              "%.3f m\n",
+              stuck.front(), stuck.back(), recovered.back());
+  EXPECT_GT(stuck.front(), 0.3);
+  EXPECT_GT(stuck.back(), 0.2);
+  EXPECT_LT(recovered.back(), 0.01);
+}
+
 TEST_F(LocalizerTest, LocalizeSequenceReadsADataset) {
   const std::filesystem::path dir =
       std::filesystem::temp_directory_path() /
