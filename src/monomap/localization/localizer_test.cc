@@ -198,20 +198,27 @@ TEST_F(LocalizerTest, SixDofMccEstimateRefinementReducesError) {
   EXPECT_LT(mean[1], 0.9 * mean[0]);  // measured 0.43 vs 0.54 mm
 }
 
-void GlobalInitCase(LocalizerTest* t, LocalizationMethod method,
-                    std::vector<double>* e,
-                    std::vector<LocalizerStepStats>* stats) {
+// Planar-state options with the KLD range [min_particles, particles] and
+// random particles drawn over a 1 x 1 m area of the room, yaw unknown.
+LocalizerOptions PlanarOverUnitArea(LocalizationMethod method, int particles,
+                                    int min_particles) {
   LocalizerOptions o;
   o.method = method;
   o.state = LocalizationState::kPlanar;
-  o.init = LocalizationInit::kGlobal;
-  o.num_particles = 3000;
-  o.kld.max_particles = 3000;
-  o.kld.min_particles = 200;
-  o.mcc_top_k = 10;
-  // A 1 x 1 m area with yaw unknown.
+  o.num_particles = particles;
+  o.kld.max_particles = particles;
+  o.kld.min_particles = min_particles;
   o.area_min = {0.0, -0.5};
   o.area_max = {1.0, 0.5};
+  return o;
+}
+
+void GlobalInitCase(LocalizerTest* t, LocalizationMethod method,
+                    std::vector<double>* e,
+                    std::vector<LocalizerStepStats>* stats) {
+  LocalizerOptions o = PlanarOverUnitArea(method, 3000, 200);
+  o.init = LocalizationInit::kGlobal;
+  o.mcc_top_k = 10;
   o.seed = 6;
   Localizer loc(t->map(), t->camera(), o, t->mount());
   loc.Initialize(std::nullopt);
@@ -264,18 +271,12 @@ TEST_F(LocalizerTest, PlanarGlobalInitConvergesWithMcc) {
 TEST_F(LocalizerTest, MccRecoversFromAKidnappingByInjection) {
   const Drive drive = MakeDrive({0.4, 0.1, 0.5}, 40, 0.02, 1.0 * kDeg, 7);
   auto run = [&](int min_injected) {
-    LocalizerOptions o;
-    o.method = LocalizationMethod::kMcc;
-    o.state = LocalizationState::kPlanar;
-    o.num_particles = 200;
-    o.kld.max_particles = 200;
-    o.kld.min_particles = 50;
+    LocalizerOptions o =
+        PlanarOverUnitArea(LocalizationMethod::kMcc, 200, 50);
     o.init_spread_m = 0.01;
     o.init_spread_deg = 1.0;
     o.injection_fraction = 0.0;
     o.mcc_min_injected = min_injected;
-    o.area_min = {0.0, -0.5};
-    o.area_max = {1.0, 0.5};
     o.seed = 2;
     Localizer loc(map(), camera(), o, mount());
     loc.InitializeAtPose(WorldFromCamOfBase(
