@@ -46,26 +46,24 @@ class ThumbnailCache {
     if (small.channels() == 1) cv::cvtColor(small, small, cv::COLOR_GRAY2BGR);
     thumbs_[frame] = small;
   }
-  // Colour of raw pixel `px` of the track, from the observation nearest
-  // its middle whose frame has a thumbnail, else from the thumbnail frame
-  // nearest the middle observation.
+  // Colour of a track: at the observation nearest its middle whose frame
+  // has a thumbnail; a short track between thumbnails takes its middle
+  // pixel from the nearest thumbnail frame.
   Eigen::Vector3f TrackColor(const Track& track) const {
     const auto& obs = track.observations;
     if (obs.empty()) return Eigen::Vector3f::Zero();
     const int mid = static_cast<int>(obs.size()) / 2;
-    for (int d = 0; d <= mid + 1; ++d) {
-      for (const int k : {mid - d, mid + d}) {
-        if (k >= 0 && k < static_cast<int>(obs.size()) &&
-            Has(obs[k].frame)) {
-          return ColorAt(obs[k].frame, obs[k].px);
-        }
+    int best = -1;
+    for (int k = 0; k < static_cast<int>(obs.size()); ++k) {
+      if (Has(obs[k].frame) &&
+          (best < 0 || std::abs(k - mid) < std::abs(best - mid))) {
+        best = k;
       }
     }
+    if (best >= 0) return ColorAt(obs[best].frame, obs[best].px);
     const int f = obs[mid].frame;
-    const int before = f / kInterval * kInterval;
-    return ColorAt(Has(before + kInterval) && f - before > kInterval / 2
-                       ? before + kInterval
-                       : before,
+    const int nearest = (f + kInterval / 2) / kInterval * kInterval;
+    return ColorAt(Has(nearest) ? nearest : f / kInterval * kInterval,
                    obs[mid].px);
   }
 
