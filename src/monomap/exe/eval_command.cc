@@ -1,6 +1,7 @@
 // monomap eval points MAP_DIR (--plane STRUCTURE.yaml | --surface CLOUD.ply)
 // monomap eval planes MAP_DIR (--plane STRUCTURE.yaml | --surface CLOUD.ply)
 // monomap eval checkerboard MAP_DIR --structure STRUCTURE.yaml
+// monomap eval board-poses DATASET --structure STRUCTURE.yaml -o REF.txt
 // monomap eval structure MAP_DIR --structure STRUCTURE_DIR
 //     [--align none|first-pose --groundtruth GT.txt]
 // monomap eval render MAP_DIR DATASET [--stride N] [--width W]
@@ -11,6 +12,7 @@
 #include <iostream>
 #include <memory>
 
+#include "monomap/eval/board_poses.h"
 #include "monomap/eval/checkerboard_accuracy.h"
 #include "monomap/eval/point_accuracy.h"
 #include "monomap/eval/render_fidelity.h"
@@ -223,6 +225,72 @@ void RegisterEvalCommand(CLI::App& app) {
                   acc.error_m.max * 1e3);
     PrintOrWrite(j, table, ba->json);
     if (!acc.found) throw StageError("checkerboard not found in any texture");
+  });
+
+  struct BoardPoseArgs {
+    std::string dataset, structure, output, json;
+    BoardPoseOptions options;
+  };
+  auto bp = std::make_shared<BoardPoseArgs>();
+  CLI::App* board_poses = eval->add_subcommand(
+      "board-poses",
+      "A reference trajectory from the images: the camera pose of every "
+      "frame that shows the known checkerboard (PnP on its corners)");
+  board_poses->add_option("dataset", bp->dataset, "Dataset directory")
+      ->required();
+  board_poses
+      ->add_option("--structure", bp->structure,
+                   "Ground-truth structure YAML with a 'chessboard' entry")
+      ->required();
+  board_poses
+      ->add_option("-o,--output", bp->output,
+                   "Reference trajectory to write (TUM, world_from_cam)")
+      ->required();
+  board_poses
+      ->add_option("--max-rms", bp->options.max_rms_px,
+                   "Refuse poses whose corner RMS error exceeds this (px)")
+      ->check(CLI::PositiveNumber);
+  board_poses->add_option("--json", bp->json, "Write the figures as JSON");
+  board_poses->callback([bp]() {
+    DatasetOptions dataset_options;
+    dataset_options.load_groundtruth = false;
+    const Dataset dataset = LoadDataset(bp->dataset, dataset_options);
+    const CheckerboardSpec spec = ReadCheckerboardYaml(bp->structure);
+    std::vector<double> timestamps;
+    std::vector<Rigid3d> hints;  // odometry: tells the board's half turns apart
+    for (const DatasetFrame& f : dataset.frames) {
+      timestamps.push_back(f.timestamp);
+      hints.push_back(f.odometry_world_from_cam);
+    }
+    const BoardPoseReport report = EstimateBoardPoses(
+        [&](int i) { return dataset.LoadImage(static_cast<size_t>(i)); },
+        timestamps, hints, dataset.camera, spec, bp->options);
+    if (report.poses.empty()) {
+      throw StageError(bp->dataset +
+                       ": the checkerboard was found in no frame");
+    }
+    WriteTumTrajectory(bp->output, report.poses,
+                       "camera poses from checkerboard PnP (monomap eval "
+                       "board-poses)");
+    nlohmann::json j;
+    j["frames"] = report.frames;
+    j["poses"] = report.poses.size();
+    j["rms_px"] = ToJson(report.rms_px);
+    j["rotation_sigma_deg"] = ToJson(report.rotation_sigma_deg);
+    j["position_sigma_m"] = ToJson(report.position_sigma_m);
+    char table[400];
+    std::snprintf(table, sizeof(table),
+                  "board poses: %zu of %d frames -> %s\n"
+                  "corner RMS error (px): median %.3f, max %.3f\n"
+                  "formal sigma, rotation (deg): median %.4f, max %.4f\n"
+                  "formal sigma, camera centre (mm): median %.3f, max %.3f\n",
+                  report.poses.size(), report.frames, bp->output.c_str(),
+                  report.rms_px.median, report.rms_px.max,
+                  report.rotation_sigma_deg.median,
+                  report.rotation_sigma_deg.max,
+                  report.position_sigma_m.median * 1e3,
+                  report.position_sigma_m.max * 1e3);
+    PrintOrWrite(j, table, bp->json);
   });
 
   struct StructureArgs {
