@@ -27,6 +27,7 @@ void RegisterBuildCommand(CLI::App& app) {
     int affine_interval = KltTrackerOptions().affine_interval;
     bool quiet = false;
     bool ba_verbose = false;
+    BundleAdjustmentOptions ba;
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
@@ -61,6 +62,23 @@ void RegisterBuildCommand(CLI::App& app) {
                   "Align each feature with its reference patch every n-th "
                   "frame (corrections in between interpolated)")
       ->check(CLI::Range(1, 1000000));
+  cmd->add_option("--odometry-translation-sigma",
+                  args->ba.translation_sigma_fraction,
+                  "Bundle adjustment's odometry prior: translation sigma per "
+                  "step as a fraction of the step length")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--odometry-rotation-sigma-deg",
+                  args->ba.rotation_sigma_floor_deg,
+                  "Bundle adjustment's odometry prior: rotation sigma per "
+                  "step (degrees)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--odometry-rotation-sigma-deg-per-m",
+                  args->ba.rotation_sigma_deg_per_m,
+                  "Bundle adjustment's odometry prior: rotation sigma added "
+                  "per metre of the step (degrees)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_flag("--refine-distortion", args->ba.refine_distortion,
+                "Bundle adjustment refines the lens distortion coefficients");
   cmd->add_flag("-q,--quiet", args->quiet, "No progress output");
   cmd->add_flag("--ba-verbose", args->ba_verbose,
                 "Print the bundle adjustment solver's progress and report");
@@ -73,6 +91,7 @@ void RegisterBuildCommand(CLI::App& app) {
     const Dataset dataset = LoadDataset(args->dataset, dataset_options);
 
     MappingOptions options;
+    options.bundle_adjustment = args->ba;
     options.bundle_adjustment.enabled = !args->no_bundle_adjustment;
     options.points_only = args->points_only;
     options.bundle_adjustment.verbose = args->ba_verbose;

@@ -162,7 +162,9 @@ MappingResult BuildMap(const Dataset& dataset, const MappingOptions& options) {
     throw StageError("need at least 2 frames to build a map, got " +
                      std::to_string(num_frames));
   }
-  const Camera& camera = dataset.camera;
+  // The dataset's calibration; bundle adjustment may refine its distortion,
+  // and every stage after it (and the map) uses the refined lens.
+  Camera camera = dataset.camera;
   camera.Check();
 
   // Stage 1: tracking (decoding overlaps tracking inside TrackFeatures).
@@ -225,6 +227,7 @@ MappingResult BuildMap(const Dataset& dataset, const MappingOptions& options) {
     report.bundle_adjustment = BundleAdjustKeyframes(
         camera, result.tracks, ba, options.keyframe_interval, &world_from_cam,
         &landmarks);
+    camera.distortion = report.bundle_adjustment.distortion;
     report.timings.push_back({"bundle_adjustment", timer.ElapsedSeconds()});
     timer.Restart();
     report.retriangulation =
@@ -319,6 +322,7 @@ nlohmann::json MappingReport::ToJson() const {
        bundle_adjustment.final_median_error_px},
       {"iterations", bundle_adjustment.iterations},
       {"covisibility", bundle_adjustment.covisibility},
+      {"distortion", bundle_adjustment.distortion},
       {"linear_solver", bundle_adjustment.linear_solver},
       {"points_dropped", bundle_adjustment.num_dropped},
       {"mean_pose_change_m", bundle_adjustment.mean_pose_change_m},

@@ -56,8 +56,21 @@ struct ReprojectionCost {
                    const Eigen::Vector2d& observed)
       : intrinsics(intrinsics), observed(observed) {}
 
+  // With the camera's fixed distortion.
   template <typename T>
   bool operator()(const T* pose, const T* x, T* residual) const {
+    return Residual(pose, x, intrinsics.v + 4, residual);
+  }
+  // With the distortion (k1, k2, p1, p2, k3) as a parameter block.
+  template <typename T>
+  bool operator()(const T* pose, const T* x, const T* distortion,
+                  T* residual) const {
+    return Residual(pose, x, distortion, residual);
+  }
+
+  template <typename T, typename D>
+  bool Residual(const T* pose, const T* x, const D* distortion,
+                T* residual) const {
     const Eigen::Map<const Eigen::Quaternion<T>> rotation(pose);
     const Eigen::Map<const Eigen::Matrix<T, 3, 1>> translation(pose + 4);
     const Eigen::Map<const Eigen::Matrix<T, 3, 1>> x_in_world(x);
@@ -65,7 +78,8 @@ struct ReprojectionCost {
     // A point crossing the image plane has no projection: reject the step.
     if (!(x_in_cam.z() > T(1e-6))) return false;
     T px[2];
-    internal::ProjectToImage(intrinsics, x_in_cam.data(), px);
+    internal::ProjectWithDistortion(intrinsics, distortion, x_in_cam.data(),
+                                    px);
     residual[0] = px[0] - observed.x();
     residual[1] = px[1] - observed.y();
     return true;
@@ -74,6 +88,11 @@ struct ReprojectionCost {
   static ceres::CostFunction* Create(const internal::Intrinsics& intrinsics,
                                      const Eigen::Vector2d& observed) {
     return new ceres::AutoDiffCostFunction<ReprojectionCost, 2, 7, 3>(
+        new ReprojectionCost(intrinsics, observed));
+  }
+  static ceres::CostFunction* CreateWithDistortion(
+      const internal::Intrinsics& intrinsics, const Eigen::Vector2d& observed) {
+    return new ceres::AutoDiffCostFunction<ReprojectionCost, 2, 7, 3, 5>(
         new ReprojectionCost(intrinsics, observed));
   }
 
@@ -247,6 +266,7 @@ BundleAdjustmentReport BundleAdjust(const Camera& camera,
   camera.Check();
   const Timer timer;
   BundleAdjustmentReport report;
+  report.distortion = camera.distortion;
   const int num_frames = static_cast<int>(world_from_cam->size());
 
   // Match landmarks to their tracks by id.
@@ -306,6 +326,8 @@ BundleAdjustmentReport BundleAdjust(const Camera& camera,
   }
   const std::vector<char> joint =
       SelectJointPoints(landmark_tracks, options.max_points);
+  // k1, k2, p1, p2, k3; a parameter block only with refine_distortion.
+  std::array<double, 5> distortion = camera.distortion;
   std::vector<bool> observed(num_frames, false);
   int64_t sum_squared_track_length = 0;
   for (size_t i = 0; i < points.size(); ++i) {
@@ -323,8 +345,14 @@ BundleAdjustmentReport BundleAdjust(const Camera& camera,
     sum_squared_track_length += k * k;
     for (const Observation& obs : landmark_tracks[i]->observations) {
       PoseParams& p = poses[obs.frame];
-      problem.AddResidualBlock(ReprojectionCost::Create(intrinsics, obs.px),
-                               loss, p.v, points[i].data());
+      if (options.refine_distortion) {
+        problem.AddResidualBlock(
+            ReprojectionCost::CreateWithDistortion(intrinsics, obs.px), loss,
+            p.v, points[i].data(), distortion.data());
+      } else {
+        problem.AddResidualBlock(ReprojectionCost::Create(intrinsics, obs.px),
+                                 loss, p.v, points[i].data());
+      }
       observed[obs.frame] = true;
       ++report.num_residuals;
     }
@@ -392,6 +420,9 @@ BundleAdjustmentReport BundleAdjust(const Camera& camera,
     if (!problem.HasParameterBlock(poses[i].v)) continue;
     ordering->AddElementToGroup(poses[i].v, 1);
   }
+  if (problem.HasParameterBlock(distortion.data())) {
+    ordering->AddElementToGroup(distortion.data(), 1);
+  }
 
   ceres::Solver::Options solver_options;
   int num_pose_blocks = 0;
@@ -437,6 +468,11 @@ BundleAdjustmentReport BundleAdjust(const Camera& camera,
   if (summary.termination_type == ceres::FAILURE) {
     throw StageError("bundle adjustment failed: " + summary.message);
   }
+  // From here on (landmarks refined alone, errors, filtering) the refined
+  // lens.
+  Camera adjusted_camera = camera;
+  adjusted_camera.distortion = distortion;
+  report.distortion = distortion;
 
   // Write back poses and their change.
   double sum_change_m = 0.0, sum_change_rad = 0.0;
@@ -470,23 +506,23 @@ BundleAdjustmentReport BundleAdjust(const Camera& camera,
                     [&](const tbb::blocked_range<size_t>& range) {
                       for (size_t i = range.begin(); i != range.end(); ++i) {
                         if (joint[i] || !points[i].allFinite()) continue;
-                        RefinePoint(camera, cams_from_world,
+                        RefinePoint(adjusted_camera, cams_from_world,
                                     *landmark_tracks[i], refine_options,
                                     &points[i]);
                       }
                     });
 
-  RmsAndMedian(
-      ReprojectionErrors(camera, cams_from_world, landmark_tracks, points),
-      &report.final_rms_error_px, &report.final_median_error_px);
+  RmsAndMedian(ReprojectionErrors(adjusted_camera, cams_from_world,
+                                  landmark_tracks, points),
+               &report.final_rms_error_px, &report.final_median_error_px);
 
   // Update landmarks; drop the ones bundle adjustment could not reconcile.
   std::vector<Landmark> kept;
   kept.reserve(landmarks->size());
   for (size_t i = 0; i < landmarks->size(); ++i) {
     Landmark l = (*landmarks)[i];
-    const PointStatistics s =
-        EvaluatePoint(camera, cams_from_world, *landmark_tracks[i], points[i]);
+    const PointStatistics s = EvaluatePoint(adjusted_camera, cams_from_world,
+                                            *landmark_tracks[i], points[i]);
     if (!points[i].allFinite() ||
         s.mean_error_px > options.max_reprojection_error_px ||
         s.min_depth_m < options.min_depth_m) {
