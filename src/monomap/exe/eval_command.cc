@@ -2,6 +2,7 @@
 // monomap eval planes MAP_DIR (--plane STRUCTURE.yaml | --surface CLOUD.ply)
 // monomap eval checkerboard MAP_DIR --structure STRUCTURE.yaml
 // monomap eval board-poses DATASET --structure STRUCTURE.yaml -o REF.txt
+// monomap eval lens MAP_DIR [--trajectory REF.txt]
 // monomap eval structure MAP_DIR --structure STRUCTURE_DIR
 //     [--align none|first-pose --groundtruth GT.txt]
 // monomap eval render MAP_DIR DATASET [--stride N] [--width W]
@@ -14,6 +15,7 @@
 
 #include "monomap/eval/board_poses.h"
 #include "monomap/eval/checkerboard_accuracy.h"
+#include "monomap/eval/lens_residuals.h"
 #include "monomap/eval/point_accuracy.h"
 #include "monomap/eval/render_fidelity.h"
 #include "monomap/eval/report_json.h"
@@ -291,6 +293,70 @@ void RegisterEvalCommand(CLI::App& app) {
                   report.position_sigma_m.median * 1e3,
                   report.position_sigma_m.max * 1e3);
     PrintOrWrite(j, table, bp->json);
+  });
+
+  struct LensArgs {
+    std::string map_dir, trajectory, json;
+    LensResidualOptions options;
+  };
+  auto la = std::make_shared<LensArgs>();
+  CLI::App* lens = eval->add_subcommand(
+      "lens",
+      "Check the lens calibration at the rim: residuals of the map's tracks, "
+      "fixed by their central observations, by distance from the centre");
+  lens->add_option("map", la->map_dir, "Map directory (with features.csv)")
+      ->required();
+  lens->add_option("--trajectory", la->trajectory,
+                   "Poses to trust (TUM), e.g. from 'eval board-poses'; "
+                   "default: the map's own");
+  lens->add_option("--centre-radius", la->options.centre_radius_px,
+                   "Observations within this radius (px) fix the points")
+      ->check(CLI::PositiveNumber);
+  lens->add_option("--json", la->json, "Write the figures as JSON");
+  lens->callback([la]() {
+    const Map map = ReadMap(la->map_dir);
+    const auto tracks =
+        ReadFeatureTable(std::filesystem::path(la->map_dir) / "features.csv");
+    std::vector<Rigid3d> world_from_cam;
+    if (la->trajectory.empty()) {
+      for (const TimedPose& p : map.trajectory) {
+        world_from_cam.push_back(p.world_from_cam);
+      }
+    } else {
+      const auto reference = ReadTumTrajectory(la->trajectory);
+      for (const TimedPose& p : map.trajectory) {
+        Rigid3d pose;
+        if (!InterpolatePose(reference, p.timestamp, 0.1, &pose)) {
+          throw InputError(
+              la->trajectory, "timestamps",
+              "no pose at the map's frame time " + std::to_string(p.timestamp));
+        }
+        world_from_cam.push_back(pose);
+      }
+    }
+    const LensResidualReport report =
+        EvaluateLensResiduals(map.camera, world_from_cam, tracks, la->options);
+    nlohmann::json j;
+    j["tracks_used"] = report.tracks_used;
+    j["rings"] = nlohmann::json::array();
+    std::string table = "tracks used: " + std::to_string(report.tracks_used) +
+                        "\nradius (px)   observations   radial mean  "
+                        "radial median  tangential median (px)\n";
+    for (const LensResidualRing& r : report.rings) {
+      j["rings"].push_back({{"min_radius_px", r.min_radius_px},
+                            {"max_radius_px", r.max_radius_px},
+                            {"count", r.count},
+                            {"radial_mean_px", r.radial_mean_px},
+                            {"radial_median_px", r.radial_median_px},
+                            {"tangential_median_px", r.tangential_median_px}});
+      char line[160];
+      std::snprintf(line, sizeof(line),
+                    "%4.0f-%-4.0f %14d %13.3f %14.3f %18.3f\n", r.min_radius_px,
+                    r.max_radius_px, r.count, r.radial_mean_px,
+                    r.radial_median_px, r.tangential_median_px);
+      table += line;
+    }
+    PrintOrWrite(j, table, la->json);
   });
 
   struct StructureArgs {
