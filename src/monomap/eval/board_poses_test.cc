@@ -4,6 +4,8 @@
 
 #include <cmath>
 
+#include "monomap/camera/board_image_for_tests.h"
+
 namespace monomap {
 namespace {
 
@@ -20,41 +22,12 @@ Camera TestCamera() {
   return c;
 }
 
-// The spec's board (black squares, white margin of one square, grey desk
-// beyond) seen from world_from_cam: each pixel's ray is intersected with
-// z = 0, 4x4 samples per pixel.
+// The spec's board (origin 0, axes x and y) seen from world_from_cam.
 cv::Mat RenderBoard(const Camera& camera, const CheckerboardSpec& spec,
                     const Rigid3d& world_from_cam) {
-  cv::Mat image(camera.height, camera.width, CV_8UC1);
-  const Eigen::Matrix3d r = world_from_cam.RotationMatrix();
-  const Eigen::Vector3d c = world_from_cam.translation;
-  for (int v = 0; v < camera.height; ++v) {
-    for (int u = 0; u < camera.width; ++u) {
-      double sum = 0.0;
-      for (int sv = 0; sv < 4; ++sv) {
-        for (int su = 0; su < 4; ++su) {
-          const Eigen::Vector2d xn = camera.NormalizedFromImage(
-              {u - 0.375 + 0.25 * su, v - 0.375 + 0.25 * sv});
-          const Eigen::Vector3d ray = r * Eigen::Vector3d(xn.x(), xn.y(), 1);
-          const double s = -c.z() / ray.z();
-          const Eigen::Vector3d x = c + s * ray;
-          // Square indices: corner (i, j) is where squares meet.
-          const double a = x.x() / spec.square_m, b = x.y() / spec.square_m;
-          const bool board = a > -2 && b > -2 && a < spec.inner_corners_x + 1 &&
-                             b < spec.inner_corners_y + 1;
-          const bool square = a > -1 && b > -1 && a < spec.inner_corners_x &&
-                              b < spec.inner_corners_y;
-          const bool black = square && (static_cast<int>(std::floor(a)) +
-                                        static_cast<int>(std::floor(b))) %
-                                               2 ==
-                                           0;
-          sum += !board ? 120.0 : black ? 20.0 : 235.0;
-        }
-      }
-      image.at<uchar>(v, u) = static_cast<uchar>(std::lround(sum / 16.0));
-    }
-  }
-  return image;
+  return testing::RenderCheckerboard(camera, spec.inner_corners_x,
+                                     spec.inner_corners_y, spec.square_m,
+                                     world_from_cam);
 }
 
 // Camera 0.35 m above the board centre, looking down at it (z of the board

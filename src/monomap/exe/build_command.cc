@@ -15,6 +15,7 @@ void RegisterBuildCommand(CLI::App& app) {
     std::string dataset;
     std::string output;
     std::string report;
+    std::string camera_yaml;
     int first_frame = 0;
     int num_frames = -1;
     bool no_bundle_adjustment = false;
@@ -37,6 +38,9 @@ void RegisterBuildCommand(CLI::App& app) {
       ->required();
   cmd->add_option("--report", args->report,
                   "Write counts and per-stage timings as JSON");
+  cmd->add_option("--camera", args->camera_yaml,
+                  "Calibration to use instead of DATASET/camera.yaml (e.g. "
+                  "from 'monomap calibrate')");
   cmd->add_option("--first-frame", args->first_frame,
                   "Index of the first frame to use");
   cmd->add_option("--frames", args->num_frames,
@@ -86,6 +90,7 @@ void RegisterBuildCommand(CLI::App& app) {
     DatasetOptions dataset_options;
     dataset_options.first_frame = args->first_frame;
     dataset_options.num_frames = args->num_frames;
+    dataset_options.camera_yaml = args->camera_yaml;
     // Ground truth is never used to build maps.
     dataset_options.load_groundtruth = false;
     const Dataset dataset = LoadDataset(args->dataset, dataset_options);

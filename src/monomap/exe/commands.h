@@ -13,5 +13,6 @@ void RegisterSimulateCommand(CLI::App& app);
 void RegisterDemoCommand(CLI::App& app);
 void RegisterRenderCommand(CLI::App& app);
 void RegisterLocalizeCommand(CLI::App& app);
+void RegisterCalibrateCommand(CLI::App& app);
 
 }  // namespace monomap

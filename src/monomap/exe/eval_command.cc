@@ -230,7 +230,7 @@ void RegisterEvalCommand(CLI::App& app) {
   });
 
   struct BoardPoseArgs {
-    std::string dataset, structure, output, json;
+    std::string dataset, structure, output, json, camera_yaml, anchor;
     BoardPoseOptions options;
   };
   auto bp = std::make_shared<BoardPoseArgs>();
@@ -252,10 +252,18 @@ void RegisterEvalCommand(CLI::App& app) {
       ->add_option("--max-rms", bp->options.max_rms_px,
                    "Refuse poses whose corner RMS error exceeds this (px)")
       ->check(CLI::PositiveNumber);
+  board_poses->add_option("--camera", bp->camera_yaml,
+                          "Calibration to use instead of DATASET/camera.yaml "
+                          "(e.g. from 'monomap calibrate')");
+  board_poses->add_option(
+      "--anchor", bp->anchor,
+      "Express the poses in this trajectory's frame (TUM), tied at the first "
+      "frame with a pose: e.g. the odometry a map was built in");
   board_poses->add_option("--json", bp->json, "Write the figures as JSON");
   board_poses->callback([bp]() {
     DatasetOptions dataset_options;
     dataset_options.load_groundtruth = false;
+    dataset_options.camera_yaml = bp->camera_yaml;
     const Dataset dataset = LoadDataset(bp->dataset, dataset_options);
     const CheckerboardSpec spec = ReadCheckerboardYaml(bp->structure);
     std::vector<double> timestamps;
@@ -271,7 +279,20 @@ void RegisterEvalCommand(CLI::App& app) {
       throw StageError(bp->dataset +
                        ": the checkerboard was found in no frame");
     }
-    WriteTumTrajectory(bp->output, report.poses,
+    std::vector<TimedPose> poses = report.poses;
+    if (!bp->anchor.empty()) {
+      Rigid3d anchor_pose;
+      if (!InterpolatePose(ReadTumTrajectory(bp->anchor), poses[0].timestamp,
+                           0.1, &anchor_pose)) {
+        throw InputError(bp->anchor, "timestamps",
+                         "no pose at the first board frame's time " +
+                             std::to_string(poses[0].timestamp));
+      }
+      // anchor_from_board_world, the same for every frame.
+      const Rigid3d change = anchor_pose * poses[0].world_from_cam.Inverse();
+      for (TimedPose& p : poses) p.world_from_cam = change * p.world_from_cam;
+    }
+    WriteTumTrajectory(bp->output, poses,
                        "camera poses from checkerboard PnP (monomap eval "
                        "board-poses)");
     nlohmann::json j;

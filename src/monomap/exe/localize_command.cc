@@ -17,7 +17,7 @@ namespace monomap {
 
 void RegisterLocalizeCommand(CLI::App& app) {
   struct Args {
-    std::string map_dir, dataset, output, report, particles_out;
+    std::string map_dir, dataset, output, report, particles_out, camera_yaml;
     std::string method = "mcl", init = "pose", state = "planar";
     int particles = 1000;
     std::string mcc_size, measure_size;
@@ -47,6 +47,9 @@ void RegisterLocalizeCommand(CLI::App& app) {
                   "Heaviest particles MCC corrects per update (default 64)");
   cmd->add_option("--measure-size", a->measure_size,
                   "WxH of the renders the weights compare (default 80x60)");
+  cmd->add_option("--camera", a->camera_yaml,
+                  "Calibration to use instead of DATASET/camera.yaml (e.g. "
+                  "from 'monomap calibrate')");
   cmd->add_option("--first-frame", a->first_frame, "First dataset frame");
   cmd->add_option("--frames", a->num_frames, "Number of frames");
   cmd->add_option("--seed", a->seed, "Seed of the filter");
@@ -58,6 +61,7 @@ void RegisterLocalizeCommand(CLI::App& app) {
     DatasetOptions dataset_options;
     dataset_options.first_frame = a->first_frame;
     dataset_options.num_frames = a->num_frames;
+    dataset_options.camera_yaml = a->camera_yaml;
     const Dataset dataset = LoadDataset(a->dataset, dataset_options);
     LocalizerOptions options;
     options.method = ParseLocalizationMethod(a->method);

@@ -23,6 +23,7 @@ int main(int argc, char** argv) {
   monomap::RegisterSimulateCommand(app);
   monomap::RegisterRenderCommand(app);
   monomap::RegisterLocalizeCommand(app);
+  monomap::RegisterCalibrateCommand(app);
   monomap::RegisterDemoCommand(app);
   try {
     app.parse(argc, argv);

@@ -239,7 +239,8 @@ Dataset LoadDataset(const fs::path& root, const DatasetOptions& options) {
   }
   Dataset ds;
   ds.root = fs::absolute(root);
-  ds.camera = ReadCameraYaml(root / "camera.yaml");
+  ds.camera = ReadCameraYaml(options.camera_yaml.empty() ? root / "camera.yaml"
+                                                         : options.camera_yaml);
   const std::vector<RgbEntry> rgb = ReadRgbList(root);
 
   const fs::path odom_path = root / "odometry.txt";

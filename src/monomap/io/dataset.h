@@ -30,6 +30,9 @@ struct DatasetOptions {
   int num_frames = -1;
   // Load groundtruth.txt if present (for evaluation only).
   bool load_groundtruth = true;
+  // Calibration to use instead of DATASET/camera.yaml (empty: that one),
+  // e.g. one written by `monomap calibrate`.
+  std::filesystem::path camera_yaml;
 
   void Check() const;
 };
