@@ -120,6 +120,36 @@ TEST_F(Cli, MissingDatasetIsNamed) {
   EXPECT_NE(r.output.find("/nonexistent/ds"), std::string::npos);
 }
 
+// The simulated lab corner shows no checkerboard: calibrate says so and
+// writes nothing; a malformed --board and a missing --camera file are named.
+TEST_F(Cli, CalibrateAndCameraOverrideErrors) {
+  const fs::path data = *root_ / "data";
+  const fs::path out = *root_ / "calibrated.yaml";
+  RunResult r = RunMonomap("calibrate " + data.string() + " -o " +
+                           out.string() + " --stride 4");
+  EXPECT_EQ(r.exit_code, 3) << r.output;  // a stage that cannot do its job
+  EXPECT_NE(r.output.find("board was found in 0 of 10 frames"),
+            std::string::npos)
+      << r.output;
+  EXPECT_FALSE(fs::exists(out));
+  r = RunMonomap("calibrate " + data.string() + " -o " + out.string() +
+                 " --board 9y6");
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("--board"), std::string::npos) << r.output;
+  r = RunMonomap("build " + data.string() + " -o " +
+                 (*root_ / "m_cam").string() +
+                 " -q --camera /nonexistent/camera.yaml");
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("/nonexistent/camera.yaml"), std::string::npos)
+      << r.output;
+  // The dataset's own calibration given explicitly builds the same map.
+  r = RunMonomap("build " + data.string() + " -o " +
+                 (*root_ / "m_cam").string() + " -q --camera " +
+                 (data / "camera.yaml").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_GT(ReadMap(*root_ / "m_cam").landmarks.size(), 50u);
+}
+
 TEST_F(Cli, EvalStructurePrintsTheTableAndWritesJson) {
   const fs::path data = *root_ / "data";
   const fs::path map = *root_ / "map_structure";
