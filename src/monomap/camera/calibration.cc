@@ -59,6 +59,22 @@ double RmsError(const std::vector<std::vector<cv::Point3f>>& object_points,
 
 }  // namespace
 
+std::optional<std::vector<cv::Point2f>> DetectCheckerboardCorners(
+    const cv::Mat& grey, int cols, int rows, int subpix_half_window) {
+  std::vector<cv::Point2f> corners;
+  if (!cv::findChessboardCorners(
+          grey, cv::Size(cols, rows), corners,
+          cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE)) {
+    return std::nullopt;
+  }
+  cv::cornerSubPix(
+      grey, corners, cv::Size(subpix_half_window, subpix_half_window),
+      cv::Size(-1, -1),
+      cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 50,
+                       1e-4));
+  return corners;
+}
+
 CalibrationReport CalibrateFromCheckerboard(
     const std::function<cv::Mat(int)>& load_grey, int num_frames,
     const Camera& initial, const CalibrationOptions& options) {
@@ -69,18 +85,8 @@ CalibrationReport CalibrateFromCheckerboard(
   for (int i = 0; i < num_frames; i += options.stride) frames.push_back(i);
   std::vector<std::optional<std::vector<cv::Point2f>>> found(frames.size());
   tbb::parallel_for(size_t{0}, frames.size(), [&](size_t k) {
-    const cv::Mat grey = load_grey(frames[k]);
-    std::vector<cv::Point2f> corners;
-    if (!cv::findChessboardCorners(
-            grey, pattern, corners,
-            cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE)) {
-      return;
-    }
-    cv::cornerSubPix(
-        grey, corners, cv::Size(5, 5), cv::Size(-1, -1),
-        cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 50,
-                         1e-4));
-    found[k] = std::move(corners);
+    found[k] = DetectCheckerboardCorners(load_grey(frames[k]), pattern.width,
+                                         pattern.height);
   });
 
   // The board in its own frame; corner order as OpenCV lists it. A view

@@ -12,6 +12,8 @@
 
 #include <functional>
 #include <opencv2/core.hpp>
+#include <optional>
+#include <vector>
 
 #include "monomap/camera/camera.h"
 
@@ -43,6 +45,13 @@ struct CalibrationReport {
   // the calibration is fitted only out to there.
   double max_corner_radius_px = 0.0;
 };
+
+// The inner corners of a cols x rows checkerboard in `grey` (8-bit), to
+// sub-pixel precision (cv::findChessboardCorners, then cv::cornerSubPix in
+// a window of 2 subpix_half_window + 1), in OpenCV's order: row by row,
+// starting at one of the board's corners. nullopt if not all are found.
+std::optional<std::vector<cv::Point2f>> DetectCheckerboardCorners(
+    const cv::Mat& grey, int cols, int rows, int subpix_half_window = 5);
 
 // Calibrates from frames 0, stride, 2 stride, ... < num_frames given by
 // `load_grey` (8-bit, of initial.width x initial.height; called from

@@ -11,6 +11,7 @@
 #include <opencv2/core/eigen.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "monomap/camera/calibration.h"
 #include "monomap/util/error.h"
 
 namespace monomap {
@@ -59,18 +60,12 @@ std::optional<BoardPose> EstimateBoardPose(const cv::Mat& grey,
                                            const Rigid3d& hint_world_from_cam,
                                            const BoardPoseOptions& options) {
   options.Check();
-  const cv::Size pattern(spec.inner_corners_x, spec.inner_corners_y);
-  std::vector<cv::Point2f> corners;
-  if (!cv::findChessboardCorners(
-          grey, pattern, corners,
-          cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE)) {
-    return std::nullopt;
-  }
-  const int w = options.subpix_half_window;
-  cv::cornerSubPix(
-      grey, corners, cv::Size(w, w), cv::Size(-1, -1),
-      cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 50,
-                       1e-4));
+  const std::optional<std::vector<cv::Point2f>> detected =
+      DetectCheckerboardCorners(grey, spec.inner_corners_x,
+                                spec.inner_corners_y,
+                                options.subpix_half_window);
+  if (!detected) return std::nullopt;
+  const std::vector<cv::Point2f>& corners = *detected;
 
   const cv::Matx33d k(camera.fx, 0, camera.cx, 0, camera.fy, camera.cy, 0, 0,
                       1);
