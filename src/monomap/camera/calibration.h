@@ -7,7 +7,7 @@
 // residuals, it bends the poses instead. desk_vamr_a's shipped calibration
 // fits the sequence's own board corners at 0.18 px RMS; refitted on 60 of
 // its frames, 0.048 px, and the localization's orientation error against
-// the board's poses drops from 0.33 to 0.06 deg (docs/benchmarks.md).
+// the board's poses drops from 0.33 to 0.11 deg (docs/benchmarks.md).
 #pragma once
 
 #include <functional>
