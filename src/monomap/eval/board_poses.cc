@@ -117,9 +117,7 @@ std::optional<BoardPose> EstimateBoardPose(const cv::Mat& grey,
     BoardPose pose;
     pose.world_from_cam = world_from_cam;
     pose.rms_px = rms;
-    std::nth_element(errors.begin(), errors.begin() + errors.size() / 2,
-                     errors.end());
-    pose.median_px = errors[errors.size() / 2];
+    pose.median_px = ComputeErrorStats(errors).median;
     // Covariance of (rvec, tvec): sigma^2 (J^T J)^-1 with sigma from the
     // residuals (2n - 6 degrees of freedom). A step d in rvec rotates the
     // camera by w = Jl(rvec) d (SO(3)'s left Jacobian); the camera centre

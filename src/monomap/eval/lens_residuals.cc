@@ -87,21 +87,16 @@ LensResidualReport EvaluateLensResiduals(
       tangential[ring].push_back(u.x() * d.y() - u.y() * d.x());
     }
   }
-  auto median = [](std::vector<double> v) {
-    std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-    return v[v.size() / 2];
-  };
   for (int k = 0; k < num_rings; ++k) {
     if (radial[k].empty()) continue;
     LensResidualRing ring;
     ring.min_radius_px = k * options.ring_px;
     ring.max_radius_px = (k + 1) * options.ring_px;
     ring.count = static_cast<int>(radial[k].size());
-    double sum = 0.0;
-    for (double v : radial[k]) sum += v;
-    ring.radial_mean_px = sum / ring.count;
-    ring.radial_median_px = median(radial[k]);
-    ring.tangential_median_px = median(tangential[k]);
+    const ErrorStats radial_stats = ComputeErrorStats(radial[k]);
+    ring.radial_mean_px = radial_stats.mean;
+    ring.radial_median_px = radial_stats.median;
+    ring.tangential_median_px = ComputeErrorStats(tangential[k]).median;
     report.rings.push_back(ring);
   }
   return report;
