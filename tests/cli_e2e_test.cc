@@ -132,6 +132,19 @@ TEST_F(Cli, CalibrateAndCameraOverrideErrors) {
             std::string::npos)
       << r.output;
   EXPECT_FALSE(fs::exists(out));
+  // --first-frame / --frames restrict the views (for a held-out check).
+  r = RunMonomap("calibrate " + data.string() + " -o " + out.string() +
+                 " --first-frame 6 --frames 3 --stride 1");
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_NE(r.output.find("board was found in 0 of 3 frames"),
+            std::string::npos)
+      << r.output;
+  r = RunMonomap("eval board-poses " + data.string() + " --structure " +
+                 (data / "groundtruth_structure.yaml").string() + " -o " +
+                 out.string() + " --first-frame 100000");
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("first_frame 100000"), std::string::npos)
+      << r.output;
   r = RunMonomap("calibrate " + data.string() + " -o " + out.string() +
                  " --board 9y6");
   EXPECT_EQ(r.exit_code, 1) << r.output;

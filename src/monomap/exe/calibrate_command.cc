@@ -1,4 +1,5 @@
 // monomap calibrate DATASET -o CAMERA.yaml [--board 9x6] [--square 0.04]
+//     [--first-frame F --frames N]
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -14,6 +15,7 @@ void RegisterCalibrateCommand(CLI::App& app) {
   struct Args {
     std::string dataset, output, board = "9x6";
     bool radial_only = false;
+    int first_frame = 0, num_frames = -1;
     CalibrationOptions options;
   };
   auto a = std::make_shared<Args>();
@@ -33,6 +35,12 @@ void RegisterCalibrateCommand(CLI::App& app) {
       ->check(CLI::PositiveNumber);
   cmd->add_flag("--radial-only", a->radial_only,
                 "Fit k1, k2 only (no p1, p2, k3)");
+  // A fit on part of the sequence can be checked on the rest with
+  // `eval board-poses --camera` (held-out corner RMS).
+  cmd->add_option("--first-frame", a->first_frame,
+                  "Index of the first frame to use");
+  cmd->add_option("--frames", a->num_frames,
+                  "Number of frames to use (default: all)");
   cmd->callback([a]() {
     int cols = 0, rows = 0;
     char tail = 0;
@@ -46,6 +54,8 @@ void RegisterCalibrateCommand(CLI::App& app) {
     a->options.full_distortion = !a->radial_only;
     DatasetOptions dataset_options;
     dataset_options.load_groundtruth = false;
+    dataset_options.first_frame = a->first_frame;
+    dataset_options.num_frames = a->num_frames;
     const Dataset dataset = LoadDataset(a->dataset, dataset_options);
     const CalibrationReport report = CalibrateFromCheckerboard(
         [&](int i) { return dataset.LoadImage(static_cast<size_t>(i)); },

@@ -2,6 +2,7 @@
 // monomap eval planes MAP_DIR (--plane STRUCTURE.yaml | --surface CLOUD.ply)
 // monomap eval checkerboard MAP_DIR --structure STRUCTURE.yaml
 // monomap eval board-poses DATASET --structure STRUCTURE.yaml -o REF.txt
+//     [--camera CAMERA.yaml] [--anchor TRAJ.txt] [--first-frame F --frames N]
 // monomap eval lens MAP_DIR [--trajectory REF.txt]
 // monomap eval structure MAP_DIR --structure STRUCTURE_DIR
 //     [--align none|first-pose --groundtruth GT.txt]
@@ -231,6 +232,7 @@ void RegisterEvalCommand(CLI::App& app) {
 
   struct BoardPoseArgs {
     std::string dataset, structure, output, json, camera_yaml, anchor;
+    int first_frame = 0, num_frames = -1;
     BoardPoseOptions options;
   };
   auto bp = std::make_shared<BoardPoseArgs>();
@@ -259,11 +261,17 @@ void RegisterEvalCommand(CLI::App& app) {
       "--anchor", bp->anchor,
       "Express the poses in this trajectory's frame (TUM), tied at the first "
       "frame with a pose: e.g. the odometry a map was built in");
+  board_poses->add_option("--first-frame", bp->first_frame,
+                          "Index of the first frame to use");
+  board_poses->add_option("--frames", bp->num_frames,
+                          "Number of frames to use (default: all)");
   board_poses->add_option("--json", bp->json, "Write the figures as JSON");
   board_poses->callback([bp]() {
     DatasetOptions dataset_options;
     dataset_options.load_groundtruth = false;
     dataset_options.camera_yaml = bp->camera_yaml;
+    dataset_options.first_frame = bp->first_frame;
+    dataset_options.num_frames = bp->num_frames;
     const Dataset dataset = LoadDataset(bp->dataset, dataset_options);
     const CheckerboardSpec spec = ReadCheckerboardYaml(bp->structure);
     std::vector<double> timestamps;
