@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "monomap/io/feature_table.h"
 #include "monomap/io/map_format.h"
 #include "monomap/sim/simulate.h"
 
@@ -78,6 +79,33 @@ TEST_F(Cli, BuildWritesAReadableMap) {
   EXPECT_GT(map.landmarks.size(), 50u);
   EXPECT_TRUE(fs::exists(out / "features.csv"));
   EXPECT_TRUE(fs::exists(*root_ / "report.json"));
+}
+
+// --max-image-radius leaves the rim out of the geometry, not out of the
+// feature table: the report counts exactly the table's rim observations.
+TEST_F(Cli, MaxImageRadiusLeavesTheRimOutOfTheGeometry) {
+  const fs::path out = *root_ / "map_radius";
+  const fs::path report = *root_ / "report_radius.json";
+  RunResult r = RunMonomap("build " + (*root_ / "data").string() + " -o " +
+                           out.string() + " -q --max-image-radius 100" +
+                           " --report " + report.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const Map map = ReadMap(out);
+  EXPECT_GT(map.landmarks.size(), 50u);
+  const Eigen::Vector2d centre(map.camera.cx, map.camera.cy);
+  int64_t beyond = 0;
+  for (const Track& t : ReadFeatureTable(out / "features.csv")) {
+    for (const Observation& o : t.observations) {
+      beyond += (o.px - centre).norm() > 100.0 ? 1 : 0;
+    }
+  }
+  std::ifstream in(report);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_GT(beyond, 100);
+  EXPECT_EQ(j.at("observations_beyond_radius").get<int64_t>(), beyond);
+  r = RunMonomap("build " + (*root_ / "data").string() + " -o " +
+                 out.string() + " -q --max-image-radius -5");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
 }
 
 TEST_F(Cli, MalformedOdometryLineIsNamedAndNothingIsWritten) {

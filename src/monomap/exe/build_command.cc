@@ -26,6 +26,7 @@ void RegisterBuildCommand(CLI::App& app) {
     int detection_min_missing = KltTrackerOptions().detection_min_missing;
     bool no_affine = false;
     int affine_interval = KltTrackerOptions().affine_interval;
+    double max_image_radius = 0.0;
     bool quiet = false;
     bool ba_verbose = false;
     BundleAdjustmentOptions ba;
@@ -59,6 +60,11 @@ void RegisterBuildCommand(CLI::App& app) {
                   "Detect new features only once this many are missing "
                   "(1: every frame short of --features)")
       ->check(CLI::Range(1, 1000000));
+  cmd->add_option("--max-image-radius", args->max_image_radius,
+                  "Leave observations farther than this from the principal "
+                  "point (px) out of the geometry: where the calibration is "
+                  "not known (0: use all)")
+      ->check(CLI::NonNegativeNumber);
   cmd->add_flag("--no-affine-refinement", args->no_affine,
                 "Track frame to frame only (no alignment with each "
                 "feature's reference patch)");
@@ -106,6 +112,7 @@ void RegisterBuildCommand(CLI::App& app) {
     options.tracking.detection_min_missing = args->detection_min_missing;
     options.tracking.affine_refinement = !args->no_affine;
     options.tracking.affine_interval = args->affine_interval;
+    options.max_observation_radius_px = args->max_image_radius;
     options.show_progress = !args->quiet;
     const MappingResult result = BuildMap(dataset, options);
     WriteMappingResult(args->output, result);

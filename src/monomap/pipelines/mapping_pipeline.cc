@@ -24,6 +24,8 @@ void MappingOptions::Check() const {
               "must be >= 1");
   CheckOption(first_pass_error_factor >= 1.0, "mapping.first_pass_error_factor",
               "must be >= 1");
+  CheckOption(max_observation_radius_px >= 0.0,
+              "mapping.max_observation_radius_px", "must be >= 0");
 }
 
 namespace {
@@ -192,6 +194,17 @@ MappingResult BuildMap(const Dataset& dataset, const MappingOptions& options) {
     throw StageError("tracking found no features in " + dataset.root.string());
   }
 
+  // The geometry sees only the observations where the lens is trusted.
+  std::vector<Track> inner_tracks;
+  const std::vector<Track>* tracks = &result.tracks;
+  if (options.max_observation_radius_px > 0.0) {
+    inner_tracks =
+        ObservationsWithinRadius(result.tracks, camera,
+                                 options.max_observation_radius_px,
+                                 &report.observations_beyond_radius);
+    tracks = &inner_tracks;
+  }
+
   // Stage 2: triangulation with odometry poses, then bundle adjustment.
   timer.Restart();
   std::vector<Rigid3d> world_from_cam;
@@ -211,7 +224,7 @@ MappingResult BuildMap(const Dataset& dataset, const MappingOptions& options) {
     loose.max_observation_error_px *= options.first_pass_error_factor;
   }
   report.triangulation = TriangulateTracks(camera, world_from_cam,
-                                           result.tracks, loose, &landmarks);
+                                           *tracks, loose, &landmarks);
   report.timings.push_back({"triangulation", timer.ElapsedSeconds()});
   if (landmarks.empty()) {
     throw StageError(
@@ -225,13 +238,13 @@ MappingResult BuildMap(const Dataset& dataset, const MappingOptions& options) {
     // through the robust loss; dropping uses the loose threshold too.
     ba.max_reprojection_error_px = loose.max_reprojection_error_px;
     report.bundle_adjustment = BundleAdjustKeyframes(
-        camera, result.tracks, ba, options.keyframe_interval, &world_from_cam,
+        camera, *tracks, ba, options.keyframe_interval, &world_from_cam,
         &landmarks);
     camera.distortion = report.bundle_adjustment.distortion;
     report.timings.push_back({"bundle_adjustment", timer.ElapsedSeconds()});
     timer.Restart();
     report.retriangulation =
-        TriangulateTracks(camera, world_from_cam, result.tracks,
+        TriangulateTracks(camera, world_from_cam, *tracks,
                           options.triangulation, &landmarks);
     report.timings.push_back({"retriangulation", timer.ElapsedSeconds()});
   }
@@ -268,12 +281,12 @@ MappingResult BuildMap(const Dataset& dataset, const MappingOptions& options) {
     timer.Restart();
     std::vector<ImagePlaneHomography> homographies;
     report.homographies = ComputeImagePlaneHomographies(
-        camera, world_from_cam, result.segments, landmarks, result.tracks,
+        camera, world_from_cam, result.segments, landmarks, *tracks,
         options.homographies, &homographies);
     report.timings.push_back({"homographies", timer.ElapsedSeconds()});
     timer.Restart();
     report.mosaic = BuildTexturedPlanes(
-        camera, world_from_cam, result.segments, landmarks, result.tracks,
+        camera, world_from_cam, result.segments, landmarks, *tracks,
         homographies, load_image, options.mosaic, &result.map.planes);
     report.timings.push_back({"mosaic", timer.ElapsedSeconds()});
   }
@@ -292,6 +305,7 @@ nlohmann::json MappingReport::ToJson() const {
       {"affine_refined", tracking.refined},
       {"reference_patches_renewed", tracking.reanchored},
       {"seconds", tracking.seconds}};
+  j["observations_beyond_radius"] = observations_beyond_radius;
   j["triangulation"] = {
       {"tracks_in", triangulation.num_tracks},
       {"points", triangulation.num_points},

@@ -35,6 +35,13 @@ struct MappingOptions {
   // The first triangulation (against odometry poses, before bundle
   // adjustment) accepts reprojection errors this many times larger.
   double first_pass_error_factor = 4.0;
+  // Observations farther than this from the principal point (raw px) are
+  // left out of triangulation, bundle adjustment, the homographies and the
+  // mosaics' feature checks (0: none left out); the feature table keeps
+  // them. Set it to where the calibration is known: a lens fitted on board
+  // views is extrapolated beyond the corners they reached, and a few rim
+  // observations then bend every pose (ObservationsWithinRadius).
+  double max_observation_radius_px = 0.0;
   // Bundle adjustment runs on every n-th frame (1: all frames); the other
   // frames get the interpolated correction of their neighbours.
   int keyframe_interval = 3;
@@ -55,6 +62,8 @@ struct StageTiming {
 struct MappingReport {
   int num_frames = 0;
   TrackingReport tracking;
+  // Observations beyond max_observation_radius_px, left out of the geometry.
+  int64_t observations_beyond_radius = 0;
   TriangulationReport triangulation;
   BundleAdjustmentReport bundle_adjustment;
   // Triangulation against the adjusted poses (strict thresholds).

@@ -313,4 +313,29 @@ TriangulationReport TriangulateTracks(const Camera& camera,
   return report;
 }
 
+std::vector<Track> ObservationsWithinRadius(const std::vector<Track>& tracks,
+                                            const Camera& camera,
+                                            double max_radius_px,
+                                            int64_t* dropped) {
+  std::vector<Track> kept;
+  kept.reserve(tracks.size());
+  int64_t removed = 0;
+  const double r2 = max_radius_px * max_radius_px;
+  for (const Track& t : tracks) {
+    Track k;
+    k.id = t.id;
+    for (const Observation& o : t.observations) {
+      const double du = o.px.x() - camera.cx, dv = o.px.y() - camera.cy;
+      if (du * du + dv * dv <= r2) {
+        k.observations.push_back(o);
+      } else {
+        ++removed;
+      }
+    }
+    if (!k.observations.empty()) kept.push_back(std::move(k));
+  }
+  if (dropped) *dropped = removed;
+  return kept;
+}
+
 }  // namespace monomap

@@ -9,6 +9,7 @@
 // output keeps the order of the input tracks.
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 #include "monomap/camera/camera.h"
@@ -100,5 +101,17 @@ void RefinePoint(const Camera& camera,
                  const std::vector<Rigid3d>& cams_from_world,
                  const Track& track, const TriangulationOptions& options,
                  Eigen::Vector3d* x_in_world);
+
+// Copy of `tracks` without the observations farther than max_radius_px
+// from the principal point (raw pixels); tracks left empty are dropped.
+// Why: a calibration is only known where its views put their corners (a
+// checkerboard seldom reaches the image's corners); beyond, its
+// distortion polynomial extrapolates, and bundle adjustment bends the
+// poses to fit it while the residuals stay at the noise. *dropped (if
+// given) receives the number of observations removed.
+std::vector<Track> ObservationsWithinRadius(const std::vector<Track>& tracks,
+                                            const Camera& camera,
+                                            double max_radius_px,
+                                            int64_t* dropped = nullptr);
 
 }  // namespace monomap
