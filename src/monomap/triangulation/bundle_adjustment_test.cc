@@ -125,6 +125,22 @@ TEST(BundleAdjustmentTest, CorrectsOdometryDrift) {
   EXPECT_LT(after.mean_rotation_deg, before.mean_rotation_deg / 2.0);
 }
 
+// Triangulates `tracks` with `camera` against the odometry, adjusts, and
+// compares with the scene's truth.
+Errors AdjustWithLens(const SyntheticScene& scene, const Camera& camera,
+                      const std::vector<Track>& tracks,
+                      const std::vector<Rigid3d>& odometry,
+                      const BundleAdjustmentOptions& options,
+                      BundleAdjustmentReport* report = nullptr) {
+  std::vector<Rigid3d> poses = odometry;
+  std::vector<Landmark> landmarks;
+  TriangulateTracks(camera, poses, tracks, TriangulationOptions(), &landmarks);
+  const BundleAdjustmentReport r =
+      BundleAdjust(camera, tracks, options, &poses, &landmarks);
+  if (report) *report = r;
+  return Compare(scene, poses, landmarks);
+}
+
 // A calibration whose k1 is off by 0.02 (~1.5 px at 300 px from the centre)
 // bends the adjusted poses; refining the distortion in the adjustment finds
 // the lens again and straightens them.
@@ -135,14 +151,10 @@ TEST(BundleAdjustmentTest, RefinesAWrongDistortion) {
   const std::vector<Rigid3d> odometry =
       SimulateOdometryDrift(scene.world_from_cam, OdometryDriftOptions());
   auto run = [&](bool refine, BundleAdjustmentReport* report) {
-    std::vector<Rigid3d> poses = odometry;
-    std::vector<Landmark> landmarks;
-    TriangulateTracks(wrong, poses, scene.tracks, TriangulationOptions(),
-                      &landmarks);
     BundleAdjustmentOptions options;
     options.refine_distortion = refine;
-    *report = BundleAdjust(wrong, scene.tracks, options, &poses, &landmarks);
-    return Compare(scene, poses, landmarks);
+    return AdjustWithLens(scene, wrong, scene.tracks, odometry, options,
+                          report);
   };
   BundleAdjustmentReport fixed_report, refined_report;
   const Errors fixed = run(false, &fixed_report);
@@ -178,13 +190,8 @@ TEST(BundleAdjustmentTest, ObservationsBeyondTheCalibratedRadiusLeftOut) {
   const std::vector<Rigid3d> odometry =
       SimulateOdometryDrift(scene.world_from_cam, OdometryDriftOptions());
   auto run = [&](const std::vector<Track>& tracks) {
-    std::vector<Rigid3d> poses = odometry;
-    std::vector<Landmark> landmarks;
-    TriangulateTracks(wrong, poses, tracks, TriangulationOptions(),
-                      &landmarks);
-    BundleAdjust(wrong, tracks, BundleAdjustmentOptions(), &poses,
-                 &landmarks);
-    return Compare(scene, poses, landmarks);
+    return AdjustWithLens(scene, wrong, tracks, odometry,
+                          BundleAdjustmentOptions());
   };
   int64_t dropped = 0;
   const std::vector<Track> inner =
