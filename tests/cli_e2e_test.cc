@@ -86,9 +86,9 @@ TEST_F(Cli, BuildWritesAReadableMap) {
 TEST_F(Cli, MaxImageRadiusLeavesTheRimOutOfTheGeometry) {
   const fs::path out = *root_ / "map_radius";
   const fs::path report = *root_ / "report_radius.json";
-  RunResult r = RunMonomap("build " + (*root_ / "data").string() + " -o " +
-                           out.string() + " -q --max-image-radius 100" +
-                           " --report " + report.string());
+  RunResult r =
+      RunMonomap("build " + (*root_ / "data").string() + " -o " + out.string() +
+                 " -q --max-image-radius 100" + " --report " + report.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const Map map = ReadMap(out);
   EXPECT_GT(map.landmarks.size(), 50u);
@@ -103,8 +103,8 @@ TEST_F(Cli, MaxImageRadiusLeavesTheRimOutOfTheGeometry) {
   const nlohmann::json j = nlohmann::json::parse(in);
   EXPECT_GT(beyond, 100);
   EXPECT_EQ(j.at("observations_beyond_radius").get<int64_t>(), beyond);
-  r = RunMonomap("build " + (*root_ / "data").string() + " -o " +
-                 out.string() + " -q --max-image-radius -5");
+  r = RunMonomap("build " + (*root_ / "data").string() + " -o " + out.string() +
+                 " -q --max-image-radius -5");
   EXPECT_EQ(r.exit_code, 2) << r.output;
 }
 
@@ -171,8 +171,7 @@ TEST_F(Cli, CalibrateAndCameraOverrideErrors) {
                  (data / "groundtruth_structure.yaml").string() + " -o " +
                  out.string() + " --first-frame 100000");
   EXPECT_EQ(r.exit_code, 1) << r.output;
-  EXPECT_NE(r.output.find("first_frame 100000"), std::string::npos)
-      << r.output;
+  EXPECT_NE(r.output.find("first_frame 100000"), std::string::npos) << r.output;
   r = RunMonomap("calibrate " + data.string() + " -o " + out.string() +
                  " --board 9y6");
   EXPECT_EQ(r.exit_code, 1) << r.output;

@@ -198,10 +198,9 @@ MappingResult BuildMap(const Dataset& dataset, const MappingOptions& options) {
   std::vector<Track> inner_tracks;
   const std::vector<Track>* tracks = &result.tracks;
   if (options.max_observation_radius_px > 0.0) {
-    inner_tracks =
-        ObservationsWithinRadius(result.tracks, camera,
-                                 options.max_observation_radius_px,
-                                 &report.observations_beyond_radius);
+    inner_tracks = ObservationsWithinRadius(result.tracks, camera,
+                                            options.max_observation_radius_px,
+                                            &report.observations_beyond_radius);
     tracks = &inner_tracks;
   }
 
@@ -223,8 +222,8 @@ MappingResult BuildMap(const Dataset& dataset, const MappingOptions& options) {
     loose.max_reprojection_error_px *= options.first_pass_error_factor;
     loose.max_observation_error_px *= options.first_pass_error_factor;
   }
-  report.triangulation = TriangulateTracks(camera, world_from_cam,
-                                           *tracks, loose, &landmarks);
+  report.triangulation =
+      TriangulateTracks(camera, world_from_cam, *tracks, loose, &landmarks);
   report.timings.push_back({"triangulation", timer.ElapsedSeconds()});
   if (landmarks.empty()) {
     throw StageError(
@@ -237,15 +236,14 @@ MappingResult BuildMap(const Dataset& dataset, const MappingOptions& options) {
     // The loose first pass carries outliers: the joint solve sees them
     // through the robust loss; dropping uses the loose threshold too.
     ba.max_reprojection_error_px = loose.max_reprojection_error_px;
-    report.bundle_adjustment = BundleAdjustKeyframes(
-        camera, *tracks, ba, options.keyframe_interval, &world_from_cam,
-        &landmarks);
+    report.bundle_adjustment =
+        BundleAdjustKeyframes(camera, *tracks, ba, options.keyframe_interval,
+                              &world_from_cam, &landmarks);
     camera.distortion = report.bundle_adjustment.distortion;
     report.timings.push_back({"bundle_adjustment", timer.ElapsedSeconds()});
     timer.Restart();
-    report.retriangulation =
-        TriangulateTracks(camera, world_from_cam, *tracks,
-                          options.triangulation, &landmarks);
+    report.retriangulation = TriangulateTracks(
+        camera, world_from_cam, *tracks, options.triangulation, &landmarks);
     report.timings.push_back({"retriangulation", timer.ElapsedSeconds()});
   }
 
