@@ -42,10 +42,7 @@ void RegisterBuildCommand(CLI::App& app) {
   cmd->add_option("--camera", args->camera_yaml,
                   "Calibration to use instead of DATASET/camera.yaml (e.g. "
                   "from 'monomap calibrate')");
-  cmd->add_option("--first-frame", args->first_frame,
-                  "Index of the first frame to use");
-  cmd->add_option("--frames", args->num_frames,
-                  "Number of frames to use (default: all)");
+  AddFrameRangeOptions(cmd, &args->first_frame, &args->num_frames);
   cmd->add_flag("--no-ba", args->no_bundle_adjustment,
                 "Skip bundle adjustment (keep odometry poses)");
   cmd->add_flag("--points-only", args->points_only,

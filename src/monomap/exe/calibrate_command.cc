@@ -37,10 +37,7 @@ void RegisterCalibrateCommand(CLI::App& app) {
                 "Fit k1, k2 only (no p1, p2, k3)");
   // A fit on part of the sequence can be checked on the rest with
   // `eval board-poses --camera` (held-out corner RMS).
-  cmd->add_option("--first-frame", a->first_frame,
-                  "Index of the first frame to use");
-  cmd->add_option("--frames", a->num_frames,
-                  "Number of frames to use (default: all)");
+  AddFrameRangeOptions(cmd, &a->first_frame, &a->num_frames);
   cmd->callback([a]() {
     int cols = 0, rows = 0;
     char tail = 0;

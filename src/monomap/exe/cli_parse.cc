@@ -2,6 +2,7 @@
 
 #include <cstdio>
 
+#include "monomap/exe/commands.h"
 #include "monomap/util/error.h"
 
 namespace monomap {
@@ -17,6 +18,13 @@ void ParseImageSize(const std::string& text, const std::string& option,
   }
   *width = w;
   *height = h;
+}
+
+void AddFrameRangeOptions(CLI::App* cmd, int* first_frame, int* num_frames) {
+  cmd->add_option("--first-frame", *first_frame,
+                  "Index of the first dataset frame to use");
+  cmd->add_option("--frames", *num_frames,
+                  "Number of frames to use (default: all)");
 }
 
 }  // namespace monomap

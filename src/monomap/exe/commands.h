@@ -15,4 +15,8 @@ void RegisterRenderCommand(CLI::App& app);
 void RegisterLocalizeCommand(CLI::App& app);
 void RegisterCalibrateCommand(CLI::App& app);
 
+// --first-frame F and --frames N (the dataset frames a command uses), the
+// same for every subcommand that takes them.
+void AddFrameRangeOptions(CLI::App* cmd, int* first_frame, int* num_frames);
+
 }  // namespace monomap

@@ -261,10 +261,7 @@ void RegisterEvalCommand(CLI::App& app) {
       "--anchor", bp->anchor,
       "Express the poses in this trajectory's frame (TUM), tied at the first "
       "frame with a pose: e.g. the odometry a map was built in");
-  board_poses->add_option("--first-frame", bp->first_frame,
-                          "Index of the first frame to use");
-  board_poses->add_option("--frames", bp->num_frames,
-                          "Number of frames to use (default: all)");
+  AddFrameRangeOptions(board_poses, &bp->first_frame, &bp->num_frames);
   board_poses->add_option("--json", bp->json, "Write the figures as JSON");
   board_poses->callback([bp]() {
     DatasetOptions dataset_options;
@@ -496,8 +493,7 @@ void RegisterEvalCommand(CLI::App& app) {
       ->add_option("--min-coverage", ra->options.min_coverage,
                    "Skip frames whose render covers less of the image")
       ->capture_default_str();
-  render->add_option("--first-frame", ra->first_frame, "First dataset frame");
-  render->add_option("--frames", ra->num_frames, "Number of frames");
+  AddFrameRangeOptions(render, &ra->first_frame, &ra->num_frames);
   render
       ->add_option("--align", ra->align,
                    "none: the map is in the ground truth's frame; "

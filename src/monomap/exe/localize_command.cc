@@ -50,8 +50,7 @@ void RegisterLocalizeCommand(CLI::App& app) {
   cmd->add_option("--camera", a->camera_yaml,
                   "Calibration to use instead of DATASET/camera.yaml (e.g. "
                   "from 'monomap calibrate')");
-  cmd->add_option("--first-frame", a->first_frame, "First dataset frame");
-  cmd->add_option("--frames", a->num_frames, "Number of frames");
+  AddFrameRangeOptions(cmd, &a->first_frame, &a->num_frames);
   cmd->add_option("--seed", a->seed, "Seed of the filter");
   cmd->add_option("--report", a->report, "Per-step figures as JSON");
   cmd->add_option("--particles-out", a->particles_out,
