@@ -22,7 +22,31 @@ namespace {
 struct FeatureSighting {
   Eigen::Vector2d st;
   Eigen::Vector2d px;
+  Eigen::Vector3d x_in_world;  // the landmark itself (off the plane a bit)
 };
+
+// The sightings whose landmark projects within max_parallax_px of where
+// the pose-induced homography puts its plane projection: a landmark off
+// the plane (a key on a keyboard, a point within the plane fit's band)
+// is displaced by parallax that no homography of the plane explains, so
+// it says nothing about the homography.
+std::vector<FeatureSighting> OnPlaneSightings(
+    const std::vector<FeatureSighting>& sightings, const Eigen::Matrix3d& k,
+    const Rigid3d& cam_from_world, const Eigen::Matrix3d& pixel_from_plane,
+    double max_parallax_px) {
+  std::vector<FeatureSighting> kept;
+  kept.reserve(sightings.size());
+  for (const auto& f : sightings) {
+    const Eigen::Vector3d x_in_cam = cam_from_world * f.x_in_world;
+    const Eigen::Vector3d y = pixel_from_plane * f.st.homogeneous();
+    if (x_in_cam.z() <= 0.0 || y.z() <= 0.0) continue;
+    const Eigen::Vector2d landmark_px = (k * x_in_cam).hnormalized();
+    if ((landmark_px - y.hnormalized()).norm() <= max_parallax_px) {
+      kept.push_back(f);
+    }
+  }
+  return kept;
+}
 
 double Median(std::vector<double> v) {
   if (v.empty()) return 0.0;
@@ -88,6 +112,8 @@ void HomographyOptions::Check() const {
               "must be >= 4 (a homography needs 4 points)");
   CheckOption(ransac_threshold_px > 0.0, "homographies.ransac_threshold_px",
               "must be > 0");
+  CheckOption(max_feature_parallax_px > 0.0,
+              "homographies.max_feature_parallax_px", "must be > 0");
   CheckOption(max_corner_shift_px > 0.0, "homographies.max_corner_shift_px",
               "must be > 0");
 }
@@ -151,7 +177,7 @@ HomographyReport ComputeImagePlaneHomographies(
       for (const Observation& o : tit->second->observations) {
         if (o.frame < 0 || o.frame >= num_frames) continue;
         sightings[static_cast<size_t>(o.frame) * num_planes + p].push_back(
-            {st, UndistortedPixel(camera, o.px)});
+            {st, UndistortedPixel(camera, o.px), lit->second->x_in_world});
       }
     }
   }
@@ -193,7 +219,9 @@ HomographyReport ComputeImagePlaneHomographies(
       hp.visible_fraction = fraction;
       hp.pixel_from_plane = k * NormalizedImageFromPlane(cam_from_world,
                                                          seg.frame);
-      const auto& feats = sightings[static_cast<size_t>(f) * num_planes + p];
+      const std::vector<FeatureSighting> feats = OnPlaneSightings(
+          sightings[static_cast<size_t>(f) * num_planes + p], k,
+          cam_from_world, hp.pixel_from_plane, options.max_feature_parallax_px);
       hp.num_features = static_cast<int>(feats.size());
       hp.before = Residuals(hp.pixel_from_plane, feats);
       hp.after = hp.before;

@@ -116,6 +116,50 @@ TEST(ImagePlaneHomographyTest, RefinesWhenPoseIsOff) {
   EXPECT_GT(r2.median_residual_after_px, 2.0);
 }
 
+// Landmarks inside the plane fit's band but off the plane (keys on a
+// keyboard on a desk) are displaced by parallax; they must not be taken
+// for a homography error and warp the texture away from the poses.
+TEST(ImagePlaneHomographyTest, IgnoresParallaxOfLandmarksOffThePlane) {
+  const Camera camera = TestCamera();
+  const auto poses = TestPoses(10);
+  std::vector<PlaneSegment> segments = {
+      testing::HorizontalRectangle(0, 0.0, 0.0, 0.0, 0.6, 0.4)};
+  std::vector<Landmark> landmarks;
+  std::vector<Track> tracks;
+  testing::MakePlaneFeatures(camera, poses, 40, 0, 3, &segments[0],
+                             &landmarks, &tracks);
+  // Twice as many 15 mm above the plane (towards the cameras), labelled as
+  // the plane's.
+  PlaneSegment raised = testing::HorizontalRectangle(0, 0.0, 0.0, 0.015,
+                                                     0.6, 0.4);
+  testing::MakePlaneFeatures(camera, poses, 80, 1000, 4, &raised, &landmarks,
+                             &tracks);
+  for (FeatureId id : raised.inlier_ids) segments[0].inlier_ids.push_back(id);
+
+  std::vector<ImagePlaneHomography> hs;
+  const HomographyReport report = ComputeImagePlaneHomographies(
+      camera, poses, segments, landmarks, tracks, HomographyOptions(), &hs);
+  ASSERT_EQ(report.num_homographies, 10);
+  EXPECT_EQ(report.num_refined, 0);
+  EXPECT_LT(report.median_residual_before_px, 1e-6);
+  for (const auto& h : hs) {
+    EXPECT_FALSE(h.refined);
+    // The raised landmarks are left out, the ones on the plane kept (a
+    // raised one seen almost along the normal has under 0.5 px parallax).
+    EXPECT_GT(h.num_features, 20);
+    EXPECT_LE(h.num_features, 45);
+  }
+
+  // Taking every landmark of the plane, the parallax (several pixels at
+  // 0.5 m) looks like a homography error and triggers refinement.
+  HomographyOptions all;
+  all.max_feature_parallax_px = 1e9;
+  const HomographyReport r2 = ComputeImagePlaneHomographies(
+      camera, poses, segments, landmarks, tracks, all, &hs);
+  EXPECT_GT(r2.median_residual_before_px, 1.0);
+  EXPECT_GT(r2.num_refined, 0);
+}
+
 TEST(ImagePlaneHomographyTest, SkipsPlanesOutOfView) {
   const Camera camera = TestCamera();
   const auto poses = TestPoses(4);
@@ -136,6 +180,9 @@ TEST(ImagePlaneHomographyTest, OptionsCheck) {
   EXPECT_THROW(o.Check(), OptionsError);
   o = HomographyOptions();
   o.min_visible_fraction = 1.5;
+  EXPECT_THROW(o.Check(), OptionsError);
+  o = HomographyOptions();
+  o.max_feature_parallax_px = 0.0;
   EXPECT_THROW(o.Check(), OptionsError);
 }
 
