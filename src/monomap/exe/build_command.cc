@@ -84,6 +84,16 @@ void RegisterBuildCommand(CLI::App& app) {
                   "Bundle adjustment's odometry prior: rotation sigma added "
                   "per metre of the step (degrees)")
       ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--odometry-span", args->ba.span_poses,
+                  "Bundle adjustment's odometry prior also between poses this "
+                  "many adjusted poses (keyframes) apart (0: off); for "
+                  "odometry whose error is per-frame jitter that does not "
+                  "accumulate")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--odometry-span-rotation-sigma-deg",
+                  args->ba.span_rotation_sigma_deg,
+                  "Rotation sigma of the span priors (degrees)")
+      ->check(CLI::PositiveNumber);
   cmd->add_flag("--refine-distortion", args->ba.refine_distortion,
                 "Bundle adjustment refines the lens distortion coefficients");
   cmd->add_flag("-q,--quiet", args->quiet, "No progress output");

@@ -324,6 +324,7 @@ nlohmann::json MappingReport::ToJson() const {
   j["bundle_adjustment"] = {
       {"termination", bundle_adjustment.termination},
       {"poses", bundle_adjustment.num_poses},
+      {"span_priors", bundle_adjustment.num_span_priors},
       {"points_joint", bundle_adjustment.num_points_joint},
       {"initial_rms_reprojection_error_px",
        bundle_adjustment.initial_rms_error_px},

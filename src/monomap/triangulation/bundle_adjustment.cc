@@ -244,6 +244,11 @@ void BundleAdjustmentOptions::Check() const {
               "must be positive");
   CheckOption(rotation_sigma_deg_per_m >= 0, "rotation_sigma_deg_per_m",
               "must be >= 0");
+  CheckOption(span_poses >= 0, "span_poses", "must be >= 0 (0: off)");
+  CheckOption(span_rotation_sigma_deg > 0, "span_rotation_sigma_deg",
+              "must be positive");
+  CheckOption(span_translation_sigma_fraction >= 0,
+              "span_translation_sigma_fraction", "must be >= 0");
   CheckOption(max_points >= 0, "max_points", "must be >= 0");
   CheckOption(max_num_iterations >= 0, "max_num_iterations", "must be >= 0");
   CheckOption(function_tolerance > 0, "function_tolerance", "must be positive");
@@ -388,6 +393,21 @@ BundleAdjustmentReport BundleAdjust(const Camera& camera,
             new RelativePoseCost(measured, sigma_t, sigma_rot)),
         nullptr, poses[i].v, poses[i + 1].v);
     ++report.num_priors;
+  }
+  if (options.span_poses > 0) {
+    const double sigma_rot = options.span_rotation_sigma_deg * kDegToRad;
+    for (int i = first; i + options.span_poses <= last; ++i) {
+      const int j = i + options.span_poses;
+      const Rigid3d measured = odometry[i].Inverse() * odometry[j];
+      const double sigma_t = options.span_translation_sigma_fraction *
+                                 measured.translation.norm() +
+                             options.translation_sigma_floor_m;
+      problem.AddResidualBlock(
+          new ceres::AutoDiffCostFunction<RelativePoseCost, 6, 7, 7>(
+              new RelativePoseCost(measured, sigma_t, sigma_rot)),
+          nullptr, poses[i].v, poses[j].v);
+      ++report.num_span_priors;
+    }
   }
   for (int i = first; i <= last; ++i) {
     if (problem.HasParameterBlock(poses[i].v)) {

@@ -43,6 +43,21 @@ struct BundleAdjustmentOptions {
   double rotation_sigma_floor_deg = 0.02;
   // ... plus this much per metre travelled in the step.
   double rotation_sigma_deg_per_m = 1.0;
+  // Odometry prior over longer spans: between poses i and i + span_poses of
+  // the adjustment (keyframes, when the pipeline adjusts keyframes), for
+  // every i; 0: off. The per-step priors model the odometry's error as
+  // independent increments, which accumulate. An odometry whose error is
+  // mostly per-frame jitter that does not accumulate (desk_vamr_a's, made
+  // from board poses that jitter by ~0.05 deg a frame) is then trusted too
+  // much step by step, and too little over a span. With span priors the
+  // per-step rotation sigma can be loosened, so the images set the motion
+  // from frame to frame while the spans hold the drift.
+  int span_poses = 0;
+  // Rotation sigma of a span prior (per axis, degrees).
+  double span_rotation_sigma_deg = 0.08;
+  // Translation sigma of a span prior (per axis): this fraction of the
+  // span's odometry translation, plus translation_sigma_floor_m.
+  double span_translation_sigma_fraction = 0.05;
   // Refine the distortion coefficients (k1, k2, p1, p2, k3) with the poses
   // and points. A calibration that is off at the image's rim pulls the
   // poses: on desk_vamr_a, tracks seen at > 240 px from the centre land up
@@ -111,7 +126,8 @@ struct BundleAdjustmentReport {
   int num_points = 0;        // landmarks given
   int num_points_joint = 0;  // of which in the joint adjustment
   int num_residuals = 0;     // reprojection residual blocks (observations)
-  int num_priors = 0;        // odometry prior residual blocks
+  int num_priors = 0;        // odometry prior residual blocks (per step)
+  int num_span_priors = 0;   // odometry priors over span_poses
   double initial_rms_error_px = 0.0;  // reprojection, all observations
   double final_rms_error_px = 0.0;
   double initial_median_error_px = 0.0;
