@@ -37,18 +37,34 @@ std::vector<Rigid3d> TestPoses(int n) {
   return poses;
 }
 
-TEST(ImagePlaneHomographyTest, MatchesAnalyticProjectionForExactPoses) {
-  const Camera camera = TestCamera();
-  const auto poses = TestPoses(10);
-  std::vector<PlaneSegment> segments = {
-      testing::HorizontalRectangle(3, 0.0, 0.0, 0.0, 0.6, 0.4)};
+// One 0.6 x 0.4 m plane at z = 0 (segment id `plane_id`) seen by `frames`
+// cameras, with `count` features (ids from `first_id`) observed from the
+// true poses.
+struct OnePlaneScene {
+  Camera camera = TestCamera();
+  std::vector<Rigid3d> poses;
+  std::vector<PlaneSegment> segments;
   std::vector<Landmark> landmarks;
   std::vector<Track> tracks;
-  testing::MakePlaneFeatures(camera, poses, 50, 100, 7, &segments[0],
-                             &landmarks, &tracks);
+};
+
+OnePlaneScene MakeOnePlaneScene(int frames, int plane_id, int count,
+                                FeatureId first_id, uint32_t seed) {
+  OnePlaneScene scene;
+  scene.poses = TestPoses(frames);
+  scene.segments = {
+      testing::HorizontalRectangle(plane_id, 0.0, 0.0, 0.0, 0.6, 0.4)};
+  testing::MakePlaneFeatures(scene.camera, scene.poses, count, first_id, seed,
+                             &scene.segments[0], &scene.landmarks,
+                             &scene.tracks);
+  return scene;
+}
+
+TEST(ImagePlaneHomographyTest, MatchesAnalyticProjectionForExactPoses) {
+  const OnePlaneScene scene = MakeOnePlaneScene(10, 3, 50, 100, 7);
   std::vector<ImagePlaneHomography> hs;
   const HomographyReport report = ComputeImagePlaneHomographies(
-      camera, poses, segments, landmarks, tracks, HomographyOptions(), &hs);
+      scene.camera, scene.poses, scene.segments, scene.landmarks, scene.tracks, HomographyOptions(), &hs);
   ASSERT_EQ(report.num_homographies, 10);
   EXPECT_EQ(report.num_checked, 10);
   EXPECT_EQ(report.num_refined, 0);
@@ -56,7 +72,7 @@ TEST(ImagePlaneHomographyTest, MatchesAnalyticProjectionForExactPoses) {
 
   std::mt19937 rng(1);
   std::uniform_real_distribution<double> u(0.0, 1.0);
-  const Eigen::Matrix3d k = camera.K();
+  const Eigen::Matrix3d k = scene.camera.K();
   for (const auto& h : hs) {
     EXPECT_EQ(h.plane_id, 3);
     EXPECT_GT(h.visible_fraction, 0.5);
@@ -65,11 +81,11 @@ TEST(ImagePlaneHomographyTest, MatchesAnalyticProjectionForExactPoses) {
     EXPECT_FALSE(h.refined);
     // Plane resolution is about f / height.
     EXPECT_NEAR(h.pixels_per_meter, 280.0 / 0.5, 150.0);
-    const Rigid3d cam_from_world = poses[h.frame].Inverse();
+    const Rigid3d cam_from_world = scene.poses[h.frame].Inverse();
     double max_err = 0.0;
     for (int i = 0; i < 100; ++i) {
       const Eigen::Vector2d st(0.6 * u(rng), 0.4 * u(rng));
-      const Eigen::Vector3d x = cam_from_world * segments[0].frame.ToWorld(st);
+      const Eigen::Vector3d x = cam_from_world * scene.segments[0].frame.ToWorld(st);
       const Eigen::Vector2d expected = (k * x).hnormalized();
       max_err = std::max(
           max_err, (ApplyHomography(h.pixel_from_plane, st) - expected).norm());
@@ -79,16 +95,9 @@ TEST(ImagePlaneHomographyTest, MatchesAnalyticProjectionForExactPoses) {
 }
 
 TEST(ImagePlaneHomographyTest, RefinesWhenPoseIsOff) {
-  const Camera camera = TestCamera();
-  const auto poses = TestPoses(8);
-  std::vector<PlaneSegment> segments = {
-      testing::HorizontalRectangle(0, 0.0, 0.0, 0.0, 0.6, 0.4)};
-  std::vector<Landmark> landmarks;
-  std::vector<Track> tracks;
-  // Observations from the true poses, homographies from perturbed ones.
-  testing::MakePlaneFeatures(camera, poses, 60, 0, 3, &segments[0],
-                             &landmarks, &tracks);
-  std::vector<Rigid3d> wrong = poses;
+  // Observations from the true scene.poses, homographies from perturbed ones.
+  const OnePlaneScene scene = MakeOnePlaneScene(8, 0, 60, 0, 3);
+  std::vector<Rigid3d> wrong = scene.poses;
   for (size_t i = 0; i < wrong.size(); ++i) {
     wrong[i] = wrong[i] *
                Rigid3d(QuaternionFromRotationVector({0.008, -0.006, 0.004}),
@@ -96,7 +105,7 @@ TEST(ImagePlaneHomographyTest, RefinesWhenPoseIsOff) {
   }
   std::vector<ImagePlaneHomography> hs;
   const HomographyReport report = ComputeImagePlaneHomographies(
-      camera, wrong, segments, landmarks, tracks, HomographyOptions(), &hs);
+      scene.camera, wrong, scene.segments, scene.landmarks, scene.tracks, HomographyOptions(), &hs);
   ASSERT_EQ(report.num_homographies, 8);
   EXPECT_EQ(report.num_refined, 8);
   EXPECT_GT(report.median_residual_before_px, 2.0);
@@ -111,7 +120,7 @@ TEST(ImagePlaneHomographyTest, RefinesWhenPoseIsOff) {
   HomographyOptions no_refine;
   no_refine.refine = false;
   const HomographyReport r2 = ComputeImagePlaneHomographies(
-      camera, wrong, segments, landmarks, tracks, no_refine, &hs);
+      scene.camera, wrong, scene.segments, scene.landmarks, scene.tracks, no_refine, &hs);
   EXPECT_EQ(r2.num_refined, 0);
   EXPECT_GT(r2.median_residual_after_px, 2.0);
 }
@@ -120,31 +129,24 @@ TEST(ImagePlaneHomographyTest, RefinesWhenPoseIsOff) {
 // keyboard on a desk) are displaced by parallax; they must not be taken
 // for a homography error and warp the texture away from the poses.
 TEST(ImagePlaneHomographyTest, IgnoresParallaxOfLandmarksOffThePlane) {
-  const Camera camera = TestCamera();
-  const auto poses = TestPoses(10);
-  std::vector<PlaneSegment> segments = {
-      testing::HorizontalRectangle(0, 0.0, 0.0, 0.0, 0.6, 0.4)};
-  std::vector<Landmark> landmarks;
-  std::vector<Track> tracks;
-  testing::MakePlaneFeatures(camera, poses, 40, 0, 3, &segments[0],
-                             &landmarks, &tracks);
+  OnePlaneScene scene = MakeOnePlaneScene(10, 0, 40, 0, 3);
   // Twice as many 15 mm above the plane (towards the cameras), labelled as
   // the plane's.
   PlaneSegment raised = testing::HorizontalRectangle(0, 0.0, 0.0, 0.015,
                                                      0.6, 0.4);
-  testing::MakePlaneFeatures(camera, poses, 80, 1000, 4, &raised, &landmarks,
-                             &tracks);
-  for (FeatureId id : raised.inlier_ids) segments[0].inlier_ids.push_back(id);
+  testing::MakePlaneFeatures(scene.camera, scene.poses, 80, 1000, 4, &raised, &scene.landmarks,
+                             &scene.tracks);
+  for (FeatureId id : raised.inlier_ids) scene.segments[0].inlier_ids.push_back(id);
 
   std::vector<ImagePlaneHomography> hs;
   const HomographyReport report = ComputeImagePlaneHomographies(
-      camera, poses, segments, landmarks, tracks, HomographyOptions(), &hs);
+      scene.camera, scene.poses, scene.segments, scene.landmarks, scene.tracks, HomographyOptions(), &hs);
   ASSERT_EQ(report.num_homographies, 10);
   EXPECT_EQ(report.num_refined, 0);
   EXPECT_LT(report.median_residual_before_px, 1e-6);
   for (const auto& h : hs) {
     EXPECT_FALSE(h.refined);
-    // The raised landmarks are left out, the ones on the plane kept (a
+    // The raised scene.landmarks are left out, the ones on the plane kept (a
     // raised one seen almost along the normal has under 0.5 px parallax).
     EXPECT_GT(h.num_features, 20);
     EXPECT_LE(h.num_features, 45);
@@ -155,7 +157,7 @@ TEST(ImagePlaneHomographyTest, IgnoresParallaxOfLandmarksOffThePlane) {
   HomographyOptions all;
   all.max_feature_parallax_px = 1e9;
   const HomographyReport r2 = ComputeImagePlaneHomographies(
-      camera, poses, segments, landmarks, tracks, all, &hs);
+      scene.camera, scene.poses, scene.segments, scene.landmarks, scene.tracks, all, &hs);
   EXPECT_GT(r2.median_residual_before_px, 1.0);
   EXPECT_GT(r2.num_refined, 0);
 }
