@@ -1,9 +1,9 @@
 #include "monomap/texture/image_plane_homography.h"
 
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <random>
-
-#include <gtest/gtest.h>
 
 #include "monomap/geometry/homography.h"
 #include "monomap/texture/test_scene.h"
@@ -64,7 +64,8 @@ TEST(ImagePlaneHomographyTest, MatchesAnalyticProjectionForExactPoses) {
   const OnePlaneScene scene = MakeOnePlaneScene(10, 3, 50, 100, 7);
   std::vector<ImagePlaneHomography> hs;
   const HomographyReport report = ComputeImagePlaneHomographies(
-      scene.camera, scene.poses, scene.segments, scene.landmarks, scene.tracks, HomographyOptions(), &hs);
+      scene.camera, scene.poses, scene.segments, scene.landmarks, scene.tracks,
+      HomographyOptions(), &hs);
   ASSERT_EQ(report.num_homographies, 10);
   EXPECT_EQ(report.num_checked, 10);
   EXPECT_EQ(report.num_refined, 0);
@@ -85,7 +86,8 @@ TEST(ImagePlaneHomographyTest, MatchesAnalyticProjectionForExactPoses) {
     double max_err = 0.0;
     for (int i = 0; i < 100; ++i) {
       const Eigen::Vector2d st(0.6 * u(rng), 0.4 * u(rng));
-      const Eigen::Vector3d x = cam_from_world * scene.segments[0].frame.ToWorld(st);
+      const Eigen::Vector3d x =
+          cam_from_world * scene.segments[0].frame.ToWorld(st);
       const Eigen::Vector2d expected = (k * x).hnormalized();
       max_err = std::max(
           max_err, (ApplyHomography(h.pixel_from_plane, st) - expected).norm());
@@ -99,13 +101,14 @@ TEST(ImagePlaneHomographyTest, RefinesWhenPoseIsOff) {
   const OnePlaneScene scene = MakeOnePlaneScene(8, 0, 60, 0, 3);
   std::vector<Rigid3d> wrong = scene.poses;
   for (size_t i = 0; i < wrong.size(); ++i) {
-    wrong[i] = wrong[i] *
-               Rigid3d(QuaternionFromRotationVector({0.008, -0.006, 0.004}),
-                       Eigen::Vector3d(0.01, -0.005, 0.0));
+    wrong[i] =
+        wrong[i] * Rigid3d(QuaternionFromRotationVector({0.008, -0.006, 0.004}),
+                           Eigen::Vector3d(0.01, -0.005, 0.0));
   }
   std::vector<ImagePlaneHomography> hs;
   const HomographyReport report = ComputeImagePlaneHomographies(
-      scene.camera, wrong, scene.segments, scene.landmarks, scene.tracks, HomographyOptions(), &hs);
+      scene.camera, wrong, scene.segments, scene.landmarks, scene.tracks,
+      HomographyOptions(), &hs);
   ASSERT_EQ(report.num_homographies, 8);
   EXPECT_EQ(report.num_refined, 8);
   EXPECT_GT(report.median_residual_before_px, 2.0);
@@ -120,7 +123,8 @@ TEST(ImagePlaneHomographyTest, RefinesWhenPoseIsOff) {
   HomographyOptions no_refine;
   no_refine.refine = false;
   const HomographyReport r2 = ComputeImagePlaneHomographies(
-      scene.camera, wrong, scene.segments, scene.landmarks, scene.tracks, no_refine, &hs);
+      scene.camera, wrong, scene.segments, scene.landmarks, scene.tracks,
+      no_refine, &hs);
   EXPECT_EQ(r2.num_refined, 0);
   EXPECT_GT(r2.median_residual_after_px, 2.0);
 }
@@ -132,15 +136,17 @@ TEST(ImagePlaneHomographyTest, IgnoresParallaxOfLandmarksOffThePlane) {
   OnePlaneScene scene = MakeOnePlaneScene(10, 0, 40, 0, 3);
   // Twice as many 15 mm above the plane (towards the cameras), labelled as
   // the plane's.
-  PlaneSegment raised = testing::HorizontalRectangle(0, 0.0, 0.0, 0.015,
-                                                     0.6, 0.4);
-  testing::MakePlaneFeatures(scene.camera, scene.poses, 80, 1000, 4, &raised, &scene.landmarks,
-                             &scene.tracks);
-  for (FeatureId id : raised.inlier_ids) scene.segments[0].inlier_ids.push_back(id);
+  PlaneSegment raised =
+      testing::HorizontalRectangle(0, 0.0, 0.0, 0.015, 0.6, 0.4);
+  testing::MakePlaneFeatures(scene.camera, scene.poses, 80, 1000, 4, &raised,
+                             &scene.landmarks, &scene.tracks);
+  for (FeatureId id : raised.inlier_ids)
+    scene.segments[0].inlier_ids.push_back(id);
 
   std::vector<ImagePlaneHomography> hs;
   const HomographyReport report = ComputeImagePlaneHomographies(
-      scene.camera, scene.poses, scene.segments, scene.landmarks, scene.tracks, HomographyOptions(), &hs);
+      scene.camera, scene.poses, scene.segments, scene.landmarks, scene.tracks,
+      HomographyOptions(), &hs);
   ASSERT_EQ(report.num_homographies, 10);
   EXPECT_EQ(report.num_refined, 0);
   EXPECT_LT(report.median_residual_before_px, 1e-6);
@@ -156,8 +162,9 @@ TEST(ImagePlaneHomographyTest, IgnoresParallaxOfLandmarksOffThePlane) {
   // 0.5 m) looks like a homography error and triggers refinement.
   HomographyOptions all;
   all.max_feature_parallax_px = 1e9;
-  const HomographyReport r2 = ComputeImagePlaneHomographies(
-      scene.camera, scene.poses, scene.segments, scene.landmarks, scene.tracks, all, &hs);
+  const HomographyReport r2 =
+      ComputeImagePlaneHomographies(scene.camera, scene.poses, scene.segments,
+                                    scene.landmarks, scene.tracks, all, &hs);
   EXPECT_GT(r2.median_residual_before_px, 1.0);
   EXPECT_GT(r2.num_refined, 0);
 }
