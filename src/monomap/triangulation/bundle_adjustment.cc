@@ -380,32 +380,31 @@ BundleAdjustmentReport BundleAdjust(const Camera& camera,
   while (last > first && !observed[last]) --last;
   // With the first pose as gauge, the chain must start there.
   if (options.fix_first_pose) first = 0;
-  for (int i = first; i + 1 <= last; ++i) {
-    const Rigid3d measured = odometry[i].Inverse() * odometry[i + 1];
-    const double step = measured.translation.norm();
-    const double sigma_t = options.translation_sigma_fraction * step +
-                           options.translation_sigma_floor_m;
-    const double sigma_rot = (options.rotation_sigma_floor_deg +
-                              options.rotation_sigma_deg_per_m * step) *
-                             kDegToRad;
+  // Odometry prior on the relative pose of poses i and j.
+  auto add_prior = [&](int i, int j, double translation_fraction,
+                       double rotation_floor_deg, double rotation_deg_per_m) {
+    const Rigid3d measured = odometry[i].Inverse() * odometry[j];
+    const double length = measured.translation.norm();
+    const double sigma_t =
+        translation_fraction * length + options.translation_sigma_floor_m;
+    const double sigma_rot =
+        (rotation_floor_deg + rotation_deg_per_m * length) * kDegToRad;
     problem.AddResidualBlock(
         new ceres::AutoDiffCostFunction<RelativePoseCost, 6, 7, 7>(
             new RelativePoseCost(measured, sigma_t, sigma_rot)),
-        nullptr, poses[i].v, poses[i + 1].v);
+        nullptr, poses[i].v, poses[j].v);
+  };
+  for (int i = first; i + 1 <= last; ++i) {
+    add_prior(i, i + 1, options.translation_sigma_fraction,
+              options.rotation_sigma_floor_deg,
+              options.rotation_sigma_deg_per_m);
     ++report.num_priors;
   }
   if (options.span_poses > 0) {
-    const double sigma_rot = options.span_rotation_sigma_deg * kDegToRad;
     for (int i = first; i + options.span_poses <= last; ++i) {
-      const int j = i + options.span_poses;
-      const Rigid3d measured = odometry[i].Inverse() * odometry[j];
-      const double sigma_t = options.span_translation_sigma_fraction *
-                                 measured.translation.norm() +
-                             options.translation_sigma_floor_m;
-      problem.AddResidualBlock(
-          new ceres::AutoDiffCostFunction<RelativePoseCost, 6, 7, 7>(
-              new RelativePoseCost(measured, sigma_t, sigma_rot)),
-          nullptr, poses[i].v, poses[j].v);
+      add_prior(i, i + options.span_poses,
+                options.span_translation_sigma_fraction,
+                options.span_rotation_sigma_deg, 0.0);
       ++report.num_span_priors;
     }
   }
@@ -449,20 +448,19 @@ BundleAdjustmentReport BundleAdjust(const Camera& camera,
   for (int i = first; i <= last; ++i) {
     num_pose_blocks += problem.HasParameterBlock(poses[i].v) ? 1 : 0;
   }
-  report.covisibility = report.num_residuals > 0
-                            ? static_cast<double>(sum_squared_track_length) /
-                                  report.num_residuals
-                            : 0.0;
+  report.covisibility =
+      report.num_residuals > 0
+          ? static_cast<double>(sum_squared_track_length) / report.num_residuals
+          : 0.0;
   // CG instead of the dense solver only: the sparse one is fast on its own.
   const bool dense = num_pose_blocks <= options.dense_schur_max_poses;
   const bool iterative =
       options.iterative_schur ||
       (dense && options.iterative_schur_min_covisibility > 0.0 &&
        report.covisibility > options.iterative_schur_min_covisibility);
-  solver_options.linear_solver_type =
-      iterative ? ceres::ITERATIVE_SCHUR
-      : dense   ? ceres::DENSE_SCHUR
-                : ceres::SPARSE_SCHUR;
+  solver_options.linear_solver_type = iterative ? ceres::ITERATIVE_SCHUR
+                                      : dense   ? ceres::DENSE_SCHUR
+                                                : ceres::SPARSE_SCHUR;
   if (iterative) {
     solver_options.preconditioner_type = ceres::SCHUR_JACOBI;
     solver_options.eta = options.iterative_schur_eta;

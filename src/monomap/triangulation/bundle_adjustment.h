@@ -53,7 +53,8 @@ struct BundleAdjustmentOptions {
   // per-step rotation sigma can be loosened, so the images set the motion
   // from frame to frame while the spans hold the drift.
   int span_poses = 0;
-  // Rotation sigma of a span prior (per axis, degrees).
+  // Rotation sigma of a span prior (per axis, degrees). Fixed, not grown
+  // with the span's length: set it to the drift expected over a span.
   double span_rotation_sigma_deg = 0.08;
   // Translation sigma of a span prior (per axis): this fraction of the
   // span's odometry translation, plus translation_sigma_floor_m.
