@@ -60,12 +60,19 @@ OnePlaneScene MakeOnePlaneScene(int frames, int plane_id, int count,
   return scene;
 }
 
+// The homographies of `scene` with its true poses.
+HomographyReport ComputeFor(const OnePlaneScene& scene,
+                            const HomographyOptions& options,
+                            std::vector<ImagePlaneHomography>* hs) {
+  return ComputeImagePlaneHomographies(scene.camera, scene.poses,
+                                       scene.segments, scene.landmarks,
+                                       scene.tracks, options, hs);
+}
+
 TEST(ImagePlaneHomographyTest, MatchesAnalyticProjectionForExactPoses) {
   const OnePlaneScene scene = MakeOnePlaneScene(10, 3, 50, 100, 7);
   std::vector<ImagePlaneHomography> hs;
-  const HomographyReport report = ComputeImagePlaneHomographies(
-      scene.camera, scene.poses, scene.segments, scene.landmarks, scene.tracks,
-      HomographyOptions(), &hs);
+  const HomographyReport report = ComputeFor(scene, HomographyOptions(), &hs);
   ASSERT_EQ(report.num_homographies, 10);
   EXPECT_EQ(report.num_checked, 10);
   EXPECT_EQ(report.num_refined, 0);
@@ -144,9 +151,7 @@ TEST(ImagePlaneHomographyTest, IgnoresParallaxOfLandmarksOffThePlane) {
     scene.segments[0].inlier_ids.push_back(id);
 
   std::vector<ImagePlaneHomography> hs;
-  const HomographyReport report = ComputeImagePlaneHomographies(
-      scene.camera, scene.poses, scene.segments, scene.landmarks, scene.tracks,
-      HomographyOptions(), &hs);
+  const HomographyReport report = ComputeFor(scene, HomographyOptions(), &hs);
   ASSERT_EQ(report.num_homographies, 10);
   EXPECT_EQ(report.num_refined, 0);
   EXPECT_LT(report.median_residual_before_px, 1e-6);
