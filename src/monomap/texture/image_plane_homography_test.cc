@@ -1,9 +1,9 @@
 #include "monomap/texture/image_plane_homography.h"
 
-#include <gtest/gtest.h>
-
 #include <cmath>
 #include <random>
+
+#include <gtest/gtest.h>
 
 #include "monomap/geometry/homography.h"
 #include "monomap/texture/test_scene.h"
@@ -60,19 +60,21 @@ OnePlaneScene MakeOnePlaneScene(int frames, int plane_id, int count,
   return scene;
 }
 
-// The homographies of `scene` with its true poses.
+// The homographies of `scene` for the given poses (the true ones or not).
 HomographyReport ComputeFor(const OnePlaneScene& scene,
+                            const std::vector<Rigid3d>& poses,
                             const HomographyOptions& options,
                             std::vector<ImagePlaneHomography>* hs) {
-  return ComputeImagePlaneHomographies(scene.camera, scene.poses,
-                                       scene.segments, scene.landmarks,
-                                       scene.tracks, options, hs);
+  return ComputeImagePlaneHomographies(scene.camera, poses, scene.segments,
+                                       scene.landmarks, scene.tracks, options,
+                                       hs);
 }
 
 TEST(ImagePlaneHomographyTest, MatchesAnalyticProjectionForExactPoses) {
   const OnePlaneScene scene = MakeOnePlaneScene(10, 3, 50, 100, 7);
   std::vector<ImagePlaneHomography> hs;
-  const HomographyReport report = ComputeFor(scene, HomographyOptions(), &hs);
+  const HomographyReport report =
+      ComputeFor(scene, scene.poses, HomographyOptions(), &hs);
   ASSERT_EQ(report.num_homographies, 10);
   EXPECT_EQ(report.num_checked, 10);
   EXPECT_EQ(report.num_refined, 0);
@@ -104,7 +106,7 @@ TEST(ImagePlaneHomographyTest, MatchesAnalyticProjectionForExactPoses) {
 }
 
 TEST(ImagePlaneHomographyTest, RefinesWhenPoseIsOff) {
-  // Observations from the true scene.poses, homographies from perturbed ones.
+  // Observations from the true poses, homographies from perturbed ones.
   const OnePlaneScene scene = MakeOnePlaneScene(8, 0, 60, 0, 3);
   std::vector<Rigid3d> wrong = scene.poses;
   for (size_t i = 0; i < wrong.size(); ++i) {
@@ -113,9 +115,8 @@ TEST(ImagePlaneHomographyTest, RefinesWhenPoseIsOff) {
                            Eigen::Vector3d(0.01, -0.005, 0.0));
   }
   std::vector<ImagePlaneHomography> hs;
-  const HomographyReport report = ComputeImagePlaneHomographies(
-      scene.camera, wrong, scene.segments, scene.landmarks, scene.tracks,
-      HomographyOptions(), &hs);
+  const HomographyReport report =
+      ComputeFor(scene, wrong, HomographyOptions(), &hs);
   ASSERT_EQ(report.num_homographies, 8);
   EXPECT_EQ(report.num_refined, 8);
   EXPECT_GT(report.median_residual_before_px, 2.0);
@@ -129,9 +130,7 @@ TEST(ImagePlaneHomographyTest, RefinesWhenPoseIsOff) {
   // Without refinement the residual stays.
   HomographyOptions no_refine;
   no_refine.refine = false;
-  const HomographyReport r2 = ComputeImagePlaneHomographies(
-      scene.camera, wrong, scene.segments, scene.landmarks, scene.tracks,
-      no_refine, &hs);
+  const HomographyReport r2 = ComputeFor(scene, wrong, no_refine, &hs);
   EXPECT_EQ(r2.num_refined, 0);
   EXPECT_GT(r2.median_residual_after_px, 2.0);
 }
@@ -151,13 +150,14 @@ TEST(ImagePlaneHomographyTest, IgnoresParallaxOfLandmarksOffThePlane) {
     scene.segments[0].inlier_ids.push_back(id);
 
   std::vector<ImagePlaneHomography> hs;
-  const HomographyReport report = ComputeFor(scene, HomographyOptions(), &hs);
+  const HomographyReport report =
+      ComputeFor(scene, scene.poses, HomographyOptions(), &hs);
   ASSERT_EQ(report.num_homographies, 10);
   EXPECT_EQ(report.num_refined, 0);
   EXPECT_LT(report.median_residual_before_px, 1e-6);
   for (const auto& h : hs) {
     EXPECT_FALSE(h.refined);
-    // The raised scene.landmarks are left out, the ones on the plane kept (a
+    // The raised landmarks are left out, the ones on the plane kept (a
     // raised one seen almost along the normal has under 0.5 px parallax).
     EXPECT_GT(h.num_features, 20);
     EXPECT_LE(h.num_features, 45);
@@ -167,9 +167,7 @@ TEST(ImagePlaneHomographyTest, IgnoresParallaxOfLandmarksOffThePlane) {
   // 0.5 m) looks like a homography error and triggers refinement.
   HomographyOptions all;
   all.max_feature_parallax_px = 1e9;
-  const HomographyReport r2 =
-      ComputeImagePlaneHomographies(scene.camera, scene.poses, scene.segments,
-                                    scene.landmarks, scene.tracks, all, &hs);
+  const HomographyReport r2 = ComputeFor(scene, scene.poses, all, &hs);
   EXPECT_GT(r2.median_residual_before_px, 1.0);
   EXPECT_GT(r2.num_refined, 0);
 }

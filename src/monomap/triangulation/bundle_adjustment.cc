@@ -448,19 +448,20 @@ BundleAdjustmentReport BundleAdjust(const Camera& camera,
   for (int i = first; i <= last; ++i) {
     num_pose_blocks += problem.HasParameterBlock(poses[i].v) ? 1 : 0;
   }
-  report.covisibility =
-      report.num_residuals > 0
-          ? static_cast<double>(sum_squared_track_length) / report.num_residuals
-          : 0.0;
+  report.covisibility = report.num_residuals > 0
+                            ? static_cast<double>(sum_squared_track_length) /
+                                  report.num_residuals
+                            : 0.0;
   // CG instead of the dense solver only: the sparse one is fast on its own.
   const bool dense = num_pose_blocks <= options.dense_schur_max_poses;
   const bool iterative =
       options.iterative_schur ||
       (dense && options.iterative_schur_min_covisibility > 0.0 &&
        report.covisibility > options.iterative_schur_min_covisibility);
-  solver_options.linear_solver_type = iterative ? ceres::ITERATIVE_SCHUR
-                                      : dense   ? ceres::DENSE_SCHUR
-                                                : ceres::SPARSE_SCHUR;
+  solver_options.linear_solver_type =
+      iterative ? ceres::ITERATIVE_SCHUR
+      : dense   ? ceres::DENSE_SCHUR
+                : ceres::SPARSE_SCHUR;
   if (iterative) {
     solver_options.preconditioner_type = ceres::SCHUR_JACOBI;
     solver_options.eta = options.iterative_schur_eta;

@@ -1,11 +1,11 @@
 #include "monomap/triangulation/bundle_adjustment.h"
 
-#include <gtest/gtest.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <random>
+
+#include <gtest/gtest.h>
 
 #include "monomap/triangulation/synthetic_scene.h"
 #include "monomap/triangulation/triangulator.h"
