@@ -3,7 +3,10 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
+#include <cmath>
+#include <limits>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -11,8 +14,12 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include <opencv2/imgcodecs.hpp>
+
+#include "monomap/geometry/polygon.h"
 #include "monomap/io/feature_table.h"
 #include "monomap/io/map_format.h"
+#include "monomap/io/trajectory_io.h"
 #include "monomap/sim/simulate.h"
 
 namespace monomap {
@@ -251,6 +258,109 @@ TEST_F(Cli, EvalStructureErrorsNameThePath) {
   EXPECT_EQ(
       RunMonomap("eval structure " + (data / "structure").string()).exit_code,
       2);
+}
+
+// Distance from p to the nearest edge of the polygon (inside or out).
+double DistanceToOutline(const Polygon2d& polygon, const Eigen::Vector2d& p) {
+  double best = std::numeric_limits<double>::infinity();
+  for (size_t i = 0; i < polygon.size(); ++i) {
+    const Eigen::Vector2d& a = polygon[i];
+    const Eigen::Vector2d& b = polygon[(i + 1) % polygon.size()];
+    const Eigen::Vector2d ab = b - a;
+    const double s =
+        std::clamp((p - a).dot(ab) / std::max(ab.squaredNorm(), 1e-300), 0.0,
+                   1.0);
+    best = std::min(best, (a + s * ab - p).norm());
+  }
+  return best;
+}
+
+// `render` through the binary: the simulated world's true planes (its
+// structure/ map) from a true pose given in TUM order, at a scaled size.
+// The depth image must be the ray-plane intersection of the nearest plane;
+// bad output names are refused before anything is written.
+TEST_F(Cli, RenderWritesTheViewAndItsDepth) {
+  const fs::path structure = *root_ / "data" / "structure";
+  const std::vector<TimedPose> truth =
+      ReadTumTrajectory(*root_ / "data" / "groundtruth.txt");
+  const Rigid3d& world_from_cam = truth[20].world_from_cam;
+  const Eigen::Quaterniond& q = world_from_cam.rotation;
+  const Eigen::Vector3d& t = world_from_cam.translation;
+  char pose[256];
+  std::snprintf(pose, sizeof(pose), "%.9f %.9f %.9f %.9f %.9f %.9f %.9f",
+                t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
+  const fs::path view = *root_ / "view.png", depth = *root_ / "depth.tiff";
+  const std::string args = "render " + structure.string() + " --pose \"" +
+                           pose + "\" --size 160x120";
+  RunResult r = RunMonomap(args + " -o " + view.string() + " --depth " +
+                           depth.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const cv::Mat grey = cv::imread(view.string(), cv::IMREAD_UNCHANGED);
+  const cv::Mat z = cv::imread(depth.string(), cv::IMREAD_UNCHANGED);
+  ASSERT_EQ(grey.type(), CV_8UC1);
+  ASSERT_EQ(z.type(), CV_32FC1);
+  ASSERT_EQ(grey.size(), cv::Size(160, 120));
+  ASSERT_EQ(z.size(), cv::Size(160, 120));
+
+  const Map map = ReadMap(structure);
+  const Camera cam = map.camera.Pinhole().Scaled(160, 120);
+  int hit = 0, agree = 0, background = 0, near_edge = 0;
+  for (int v = 0; v < cam.height; ++v) {
+    for (int u = 0; u < cam.width; ++u) {
+      const Eigen::Vector3d ray_in_cam((u - cam.cx) / cam.fx,
+                                       (v - cam.cy) / cam.fy, 1.0);
+      const Eigen::Vector3d ray = world_from_cam.rotation * ray_in_cam;
+      double nearest = 0.0;  // depth along the optical axis
+      bool edge = false;
+      for (const TexturedPlane& p : map.planes) {
+        const double denom = p.plane.normal.dot(ray);
+        if (std::abs(denom) < 1e-12) continue;
+        const double lambda = -p.plane.SignedDistance(t) / denom;
+        if (lambda <= 0.0) continue;
+        const Eigen::Vector2d st = p.frame.ToPlane(t + lambda * ray);
+        // Pixels whose ray passes within 2 cm of an outline are skipped:
+        // there a pixel's centre and its coverage may disagree.
+        const bool inside = PointInPolygon(p.polygon, st);
+        if (DistanceToOutline(p.polygon, st) < 0.02) edge = true;
+        if (inside && (nearest == 0.0 || lambda < nearest)) nearest = lambda;
+      }
+      const float rendered = z.at<float>(v, u);
+      if (edge) {
+        ++near_edge;
+      } else if (nearest == 0.0) {
+        background += rendered == 0.0f;
+      } else {
+        ++hit;
+        agree += std::abs(rendered - nearest) < 1e-4 * nearest;
+      }
+    }
+  }
+  std::printf("render: %d px on a plane (%d agree), %d background, %d near "
+              "an outline\n",
+              hit, agree, background, near_edge);
+  EXPECT_GT(hit, 160 * 120 / 2);
+  EXPECT_EQ(agree, hit);
+  EXPECT_EQ(hit + background + near_edge, 160 * 120);
+
+  // Refused before rendering (usage errors), nothing written: an image
+  // format OpenCV does not know, and 32-bit depth in a format that would
+  // round it to 8 bits.
+  const fs::path view2 = *root_ / "view2.png", bad = *root_ / "view.xyz";
+  r = RunMonomap(args + " -o " + bad.string());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("view.xyz"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(bad));
+  r = RunMonomap(args + " -o " + view2.string() + " --depth " +
+                 (*root_ / "depth.png").string());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("depth.png"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(view2));
+  EXPECT_FALSE(fs::exists(*root_ / "depth.png"));
+  // An output folder that does not exist is named; exit 3 (output error).
+  r = RunMonomap(args + " -o " + (*root_ / "no_dir" / "v.png").string());
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_NE(r.output.find("no_dir/v.png: cannot open"), std::string::npos)
+      << r.output;
 }
 
 // Texture fidelity on held-out frames: a map of the first 30 frames

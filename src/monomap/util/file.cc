@@ -79,7 +79,9 @@ void WriteFileAtomic(const fs::path& path, const std::string& contents) {
   const fs::path temp = path.string() + ".tmp-" + RandomSuffix();
   {
     std::ofstream out(temp, std::ios::binary);
-    if (!out) throw OutputError(temp.string() + ": cannot open for writing");
+    // Named by the path the user gave: the temporary name means nothing
+    // to them.
+    if (!out) throw OutputError(path.string() + ": cannot open for writing");
     out.write(contents.data(), static_cast<std::streamsize>(contents.size()));
     out.flush();
     if (!out) {
