@@ -6,15 +6,14 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <limits>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <nlohmann/json.hpp>
-#include <string>
-
 #include <opencv2/imgcodecs.hpp>
+#include <string>
 
 #include "monomap/geometry/polygon.h"
 #include "monomap/io/feature_table.h"
@@ -267,9 +266,8 @@ double DistanceToOutline(const Polygon2d& polygon, const Eigen::Vector2d& p) {
     const Eigen::Vector2d& a = polygon[i];
     const Eigen::Vector2d& b = polygon[(i + 1) % polygon.size()];
     const Eigen::Vector2d ab = b - a;
-    const double s =
-        std::clamp((p - a).dot(ab) / std::max(ab.squaredNorm(), 1e-300), 0.0,
-                   1.0);
+    const double s = std::clamp(
+        (p - a).dot(ab) / std::max(ab.squaredNorm(), 1e-300), 0.0, 1.0);
     best = std::min(best, (a + s * ab - p).norm());
   }
   return best;
@@ -287,13 +285,13 @@ TEST_F(Cli, RenderWritesTheViewAndItsDepth) {
   const Eigen::Quaterniond& q = world_from_cam.rotation;
   const Eigen::Vector3d& t = world_from_cam.translation;
   char pose[256];
-  std::snprintf(pose, sizeof(pose), "%.9f %.9f %.9f %.9f %.9f %.9f %.9f",
-                t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
+  std::snprintf(pose, sizeof(pose), "%.9f %.9f %.9f %.9f %.9f %.9f %.9f", t.x(),
+                t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
   const fs::path view = *root_ / "view.png", depth = *root_ / "depth.tiff";
   const std::string args = "render " + structure.string() + " --pose \"" +
                            pose + "\" --size 160x120";
-  RunResult r = RunMonomap(args + " -o " + view.string() + " --depth " +
-                           depth.string());
+  RunResult r =
+      RunMonomap(args + " -o " + view.string() + " --depth " + depth.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const cv::Mat grey = cv::imread(view.string(), cv::IMREAD_UNCHANGED);
   const cv::Mat z = cv::imread(depth.string(), cv::IMREAD_UNCHANGED);
@@ -335,9 +333,10 @@ TEST_F(Cli, RenderWritesTheViewAndItsDepth) {
       }
     }
   }
-  std::printf("render: %d px on a plane (%d agree), %d background, %d near "
-              "an outline\n",
-              hit, agree, background, near_edge);
+  std::printf(
+      "render: %d px on a plane (%d agree), %d background, %d near "
+      "an outline\n",
+      hit, agree, background, near_edge);
   EXPECT_GT(hit, 160 * 120 / 2);
   EXPECT_EQ(agree, hit);
   EXPECT_EQ(hit + background + near_edge, 160 * 120);
