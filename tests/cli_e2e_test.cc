@@ -455,6 +455,14 @@ TEST_F(Cli, LocalizeTracksTheDatasetInItsMap) {
                 .exit_code,
             2);
   EXPECT_FALSE(fs::exists(*root_ / "x.txt"));
+  // The planar state without 2D odometry names the file it needs.
+  const fs::path no2d = CopyData("data_no_odometry2d");
+  fs::remove(no2d / "odometry2d.txt");
+  r = RunMonomap("localize " + map.string() + " " + no2d.string() + " -o " +
+                 (*root_ / "x.txt").string());
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("odometry2d.txt"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(*root_ / "x.txt"));
 }
 
 }  // namespace

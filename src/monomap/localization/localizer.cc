@@ -404,16 +404,17 @@ LocalizationReport LocalizeSequence(
   if (dataset.frames.empty()) throw InputError("localization: no frames");
   const bool planar = options.state == LocalizationState::kPlanar;
   if (planar) {
-    if (!dataset.base_from_cam) {
-      throw InputError(dataset.root.string(),
-                       "camera_mount.yaml",
-                       "the planar state needs the camera mount");
-    }
+    // 2D odometry first: the mount is read only along with it.
     for (const DatasetFrame& f : dataset.frames) {
       if (!f.odometry_base) {
         throw InputError(dataset.root.string(), "odometry2d.txt",
-                         "the planar state needs 2D odometry for every frame");
+                         "the planar state needs 2D odometry for every frame "
+                         "(or use --state 6dof)");
       }
+    }
+    if (!dataset.base_from_cam) {
+      throw InputError(dataset.root.string(), "camera_mount.yaml",
+                       "the planar state needs the camera mount");
     }
   }
   const Timer timer;
