@@ -180,7 +180,7 @@ TEST_F(Cli, CalibrateAndCameraOverrideErrors) {
   EXPECT_NE(r.output.find("first_frame 100000"), std::string::npos) << r.output;
   r = RunMonomap("calibrate " + data.string() + " -o " + out.string() +
                  " --board 9y6");
-  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_EQ(r.exit_code, 2) << r.output;  // a usage error
   EXPECT_NE(r.output.find("--board"), std::string::npos) << r.output;
   r = RunMonomap("build " + data.string() + " -o " +
                  (*root_ / "m_cam").string() +

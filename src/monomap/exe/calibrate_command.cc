@@ -43,8 +43,8 @@ void RegisterCalibrateCommand(CLI::App& app) {
     char tail = 0;
     if (std::sscanf(a->board.c_str(), "%dx%d%c", &cols, &rows, &tail) != 2 ||
         cols < 2 || rows < 2) {
-      throw InputError("--board: expected COLSxROWS of inner corners, got '" +
-                       a->board + "'");
+      throw OptionsError("--board: expected COLSxROWS of inner corners, got '" +
+                         a->board + "'");
     }
     a->options.inner_corners_x = cols;
     a->options.inner_corners_y = rows;
