@@ -9,6 +9,12 @@
 // particle budget, MCC with the same budget, MCC with a quarter of it.
 // The budget is the initial count and the KLD-sampling maximum.
 //
+// With --kidnap-after K the filter instead starts at the true pose and the
+// robot is carried off after K updates: the images jump --kidnap-skip
+// frames ahead along the traversal while the odometry goes on as if nothing
+// happened. The figures are then those of the updates after the kidnapping
+// (converged step = updates until the filter has the pose again).
+//
 // Writes every figure (and the per-step errors and particle counts) to
 // --out as JSON and prints markdown summary tables on stdout.
 //
@@ -68,6 +74,11 @@ struct SweepOptions {
   // MCC: least random particles injected per resampling (-1: the
   // localizer's default).
   int mcc_min_injected = -1;
+  // Kidnapped robot: carried off after this many updates (0: no kidnapping,
+  // global initialisation instead) ...
+  int kidnap_after = 0;
+  // ... this many frames ahead along the traversal.
+  int kidnap_skip = 60;
   LocalizationAccuracyOptions accuracy;
   std::string out = "localization_sweep.json";
   std::string keep_dir;
@@ -81,7 +92,11 @@ struct Config {
 
 struct ConfigRun {
   bool ok = false;  // the run finished (map and localization)
+  // Over the whole run, or over the updates after a kidnapping.
   LocalizationAccuracy accuracy;
+  // Kidnapping only: the filter had the pose when the robot was carried
+  // off (the last update before it within the thresholds).
+  bool tracked_before_kidnap = false;
   double mean_step_ms = 0.0;
   double mean_particles = 0.0;
   std::vector<int> particles;  // per step, after the update
@@ -121,6 +136,45 @@ std::vector<TimedPose> GroundTruth(const Dataset& d) {
     if (f.groundtruth_world_from_cam) {
       out.push_back({f.timestamp, *f.groundtruth_world_from_cam});
     }
+  }
+  return out;
+}
+
+// The robot carried off: frames [0, after) then [after + skip, end). The
+// odometry of the later frames is moved rigidly so that it continues from
+// frame after - 1 with the real step from after + skip - 1 to after + skip:
+// nothing in it shows the carrying. Ground truth stays true.
+Dataset Kidnap(const Dataset& d, int after, int skip) {
+  const int n = static_cast<int>(d.frames.size());
+  CheckOption(after >= 1 && after + skip < n, "kidnap",
+              "needs 1 <= after and after + skip < the frames simulated");
+  Dataset out = d;
+  out.frames.assign(d.frames.begin(), d.frames.begin() + after);
+  const DatasetFrame& last = d.frames[after - 1];
+  const DatasetFrame& before_cut = d.frames[after + skip - 1];
+  const Rigid3d fix =
+      last.odometry_world_from_cam * before_cut.odometry_world_from_cam.Inverse();
+  // The same rigid move in the plane, for odometry2d.
+  double theta = 0.0, c = 1.0, sn = 0.0;
+  Eigen::Vector2d shift = Eigen::Vector2d::Zero();
+  if (last.odometry_base && before_cut.odometry_base) {
+    const Pose2d& a = *last.odometry_base;
+    const Pose2d& b = *before_cut.odometry_base;
+    theta = a.yaw - b.yaw;
+    c = std::cos(theta);
+    sn = std::sin(theta);
+    shift = Eigen::Vector2d(a.x, a.y) -
+            Eigen::Vector2d(c * b.x - sn * b.y, sn * b.x + c * b.y);
+  }
+  for (int i = after + skip; i < n; ++i) {
+    DatasetFrame f = d.frames[i];
+    f.odometry_world_from_cam = fix * f.odometry_world_from_cam;
+    if (f.odometry_base) {
+      const Pose2d p = *f.odometry_base;
+      f.odometry_base = Pose2d{c * p.x - sn * p.y + shift.x(),
+                               sn * p.x + c * p.y + shift.y(), p.yaw + theta};
+    }
+    out.frames.push_back(f);
   }
   return out;
 }
@@ -181,14 +235,26 @@ nlohmann::json RunSeed(const SweepOptions& o, const std::string& world,
 
   // 2. The localization run: the same world, another traversal.
   timer.Restart();
-  sim.num_frames = o.loc_frames;
+  const bool kidnap = o.kidnap_after > 0;
+  sim.num_frames = o.loc_frames + (kidnap ? o.kidnap_skip : 0);
   sim.run_seed = o.run_seed_base + static_cast<uint64_t>(seed);
   sim.path.start_offset_m = o.start_offset_m;
   sim.path.lateral_offset_m = o.lateral_offset_m;
   const SimulationReport loc_sim = Simulate(sim, loc_data);
-  const Dataset live = LoadDataset(loc_data);
+  const Dataset live =
+      kidnap ? Kidnap(LoadDataset(loc_data), o.kidnap_after, o.kidnap_skip)
+             : LoadDataset(loc_data);
   const std::vector<TimedPose> live_truth = GroundTruth(live);
-  j["localization_run"] = {{"frames", loc_sim.frames},
+  if (kidnap) {
+    const Rigid3d& from = *live.frames[o.kidnap_after - 1].groundtruth_world_from_cam;
+    const Rigid3d& to = *live.frames[o.kidnap_after].groundtruth_world_from_cam;
+    j["kidnap"] = {
+        {"after", o.kidnap_after},
+        {"skip", o.kidnap_skip},
+        {"distance_m", (to.translation - from.translation).norm()},
+        {"rotation_deg", AngleBetween(from.rotation, to.rotation) * 180.0 / M_PI}};
+  }
+  j["localization_run"] = {{"frames", live.frames.size()},
                            {"run_seed", sim.run_seed},
                            {"path_length_m", loc_sim.path_length_m},
                            {"odometry_drift_m", loc_sim.final_drift_m},
@@ -205,7 +271,7 @@ nlohmann::json RunSeed(const SweepOptions& o, const std::string& world,
     LocalizerOptions lo;
     lo.method = configs[c].method;
     lo.state = LocalizationState::kPlanar;
-    lo.init = LocalizationInit::kGlobal;
+    lo.init = kidnap ? LocalizationInit::kPose : LocalizationInit::kGlobal;
     lo.num_particles = configs[c].particles;
     lo.use_kld = !o.fixed_count;
     lo.kld.max_particles = configs[c].particles;
@@ -216,7 +282,22 @@ nlohmann::json RunSeed(const SweepOptions& o, const std::string& world,
     const LocalizationReport r = LocalizeSequence(map, live, lo, &trajectory);
     ConfigRun& run = (*runs)[c];
     run.ok = true;
-    run.accuracy = EvaluateLocalization(trajectory, live_truth, o.accuracy);
+    if (kidnap) {
+      const auto cut = [&](const std::vector<TimedPose>& v, bool before) {
+        return before ? std::vector<TimedPose>(v.begin(),
+                                               v.begin() + o.kidnap_after)
+                      : std::vector<TimedPose>(v.begin() + o.kidnap_after,
+                                               v.end());
+      };
+      run.tracked_before_kidnap =
+          EvaluateLocalization(cut(trajectory, true), cut(live_truth, true),
+                               o.accuracy)
+              .success;
+      run.accuracy = EvaluateLocalization(cut(trajectory, false),
+                                          cut(live_truth, false), o.accuracy);
+    } else {
+      run.accuracy = EvaluateLocalization(trajectory, live_truth, o.accuracy);
+    }
     run.mean_step_ms = 1e3 * r.mean_step_seconds;
     run.mean_particles = r.mean_particles;
     nlohmann::json steps_particles = nlohmann::json::array(),
@@ -252,6 +333,7 @@ nlohmann::json RunSeed(const SweepOptions& o, const std::string& world,
         {"method", lo.method == LocalizationMethod::kMcc ? "mcc" : "mcl"},
         {"particles_budget", configs[c].particles},
         {"accuracy", run.accuracy.ToJson(true)},
+        {"tracked_before_kidnap", run.tracked_before_kidnap},
         {"seconds", r.seconds},
         {"mean_step_ms", run.mean_step_ms},
         {"mean_particles", run.mean_particles},
@@ -293,6 +375,12 @@ nlohmann::json Summarize(const SweepOptions& o, const std::string& world,
       "frames, %dx%d\n\n",
       world.c_str(), o.seeds, o.first_seed, o.first_seed + o.seeds - 1,
       o.map_frames, o.loc_frames, o.width, o.height);
+  if (o.kidnap_after > 0) {
+    std::printf(
+        "Kidnapped after update %d, %d frames ahead; the figures are those "
+        "of the updates after it.\n\n",
+        o.kidnap_after, o.kidnap_skip);
+  }
   std::printf(
       "| method | particles | success | median converged step | "
       "median final error | median mean tracking error (converged "
@@ -300,7 +388,7 @@ nlohmann::json Summarize(const SweepOptions& o, const std::string& world,
   std::printf("|---|---|---|---|---|---|---|---|\n");
   std::vector<std::string> over_time;
   for (size_t c = 0; c < configs.size(); ++c) {
-    int ok = 0, success = 0;
+    int ok = 0, success = 0, tracked = 0;
     std::vector<double> conv, final_t, final_r, mean_t, mean_r, particles, ms;
     std::vector<double> at_step(kParticleSteps.size(), 0.0);
     std::vector<int> at_count(kParticleSteps.size(), 0);
@@ -308,6 +396,7 @@ nlohmann::json Summarize(const SweepOptions& o, const std::string& world,
       const ConfigRun& r = seed_runs[c];
       if (!r.ok) continue;
       ++ok;
+      tracked += r.tracked_before_kidnap;
       const LocalizationAccuracy& a = r.accuracy;
       if (a.success) {
         ++success;
@@ -333,6 +422,7 @@ nlohmann::json Summarize(const SweepOptions& o, const std::string& world,
     s["runs"] = n;
     s["runs_finished"] = ok;
     s["successes"] = success;
+    if (o.kidnap_after > 0) s["tracked_before_kidnap"] = tracked;
     s["success_rate"] = n > 0 ? static_cast<double>(success) / n : 0.0;
     s["median_converged_step"] = Number(Median(conv));
     s["median_final_translation_error_m"] = Number(Median(final_t));
@@ -353,10 +443,14 @@ nlohmann::json Summarize(const SweepOptions& o, const std::string& world,
     over_time.push_back(row);
     summary[configs[c].name] = s;
     std::printf(
-        "| %s | %d | %d/%d | %s | %s cm / %s deg | %s cm / %s deg | "
+        "| %s | %d | %d/%d%s | %s | %s cm / %s deg | %s cm / %s deg | "
         "%s | %s |\n",
         s["method"].get<std::string>().c_str(), configs[c].particles, success,
-        n, Fmt("%.0f", Median(conv)).c_str(),
+        n,
+        o.kidnap_after > 0
+            ? (" (tracking before: " + std::to_string(tracked) + ")").c_str()
+            : "",
+        Fmt("%.0f", Median(conv)).c_str(),
         Fmt("%.1f", 100 * Median(final_t)).c_str(),
         Fmt("%.1f", Median(final_r)).c_str(),
         Fmt("%.1f", 100 * Median(mean_t)).c_str(),
@@ -414,7 +508,9 @@ int Run(const SweepOptions& o) {
       {"max_translation_error_m", o.accuracy.max_translation_error_m},
       {"max_rotation_error_deg", o.accuracy.max_rotation_error_deg},
       {"state", "planar"},
-      {"init", "global"}};
+      {"init", o.kidnap_after > 0 ? "pose" : "global"},
+      {"kidnap_after", o.kidnap_after},
+      {"kidnap_skip", o.kidnap_skip}};
   out["runs"] = nlohmann::json::array();
   out["summary"] = nlohmann::json::object();
   const Timer total;
@@ -477,6 +573,11 @@ int main(int argc, char** argv) {
   app.add_option("--mcc-min-injected", o.mcc_min_injected,
                  "MCC: least random particles injected per resampling "
                  "(-1: the localizer's default)");
+  app.add_option("--kidnap-after", o.kidnap_after,
+                 "Start at the true pose and carry the robot off after this "
+                 "many updates (0: global initialisation instead)");
+  app.add_option("--kidnap-skip", o.kidnap_skip,
+                 "Frames along the traversal the robot is carried ahead");
   app.add_option("--max-error-m", o.accuracy.max_translation_error_m,
                  "Success threshold on the position error (m)");
   app.add_option("--max-error-deg", o.accuracy.max_rotation_error_deg,
