@@ -152,8 +152,8 @@ Dataset Kidnap(const Dataset& d, int after, int skip) {
   out.frames.assign(d.frames.begin(), d.frames.begin() + after);
   const DatasetFrame& last = d.frames[after - 1];
   const DatasetFrame& before_cut = d.frames[after + skip - 1];
-  const Rigid3d fix =
-      last.odometry_world_from_cam * before_cut.odometry_world_from_cam.Inverse();
+  const Rigid3d fix = last.odometry_world_from_cam *
+                      before_cut.odometry_world_from_cam.Inverse();
   // The same rigid move in the plane, for odometry2d.
   double theta = 0.0, c = 1.0, sn = 0.0;
   Eigen::Vector2d shift = Eigen::Vector2d::Zero();
@@ -246,13 +246,14 @@ nlohmann::json RunSeed(const SweepOptions& o, const std::string& world,
              : LoadDataset(loc_data);
   const std::vector<TimedPose> live_truth = GroundTruth(live);
   if (kidnap) {
-    const Rigid3d& from = *live.frames[o.kidnap_after - 1].groundtruth_world_from_cam;
+    const Rigid3d& from =
+        *live.frames[o.kidnap_after - 1].groundtruth_world_from_cam;
     const Rigid3d& to = *live.frames[o.kidnap_after].groundtruth_world_from_cam;
-    j["kidnap"] = {
-        {"after", o.kidnap_after},
-        {"skip", o.kidnap_skip},
-        {"distance_m", (to.translation - from.translation).norm()},
-        {"rotation_deg", AngleBetween(from.rotation, to.rotation) * 180.0 / M_PI}};
+    j["kidnap"] = {{"after", o.kidnap_after},
+                   {"skip", o.kidnap_skip},
+                   {"distance_m", (to.translation - from.translation).norm()},
+                   {"rotation_deg",
+                    AngleBetween(from.rotation, to.rotation) * 180.0 / M_PI}};
   }
   j["localization_run"] = {{"frames", live.frames.size()},
                            {"run_seed", sim.run_seed},
