@@ -459,8 +459,9 @@ nlohmann::json Summarize(const SweepOptions& o, const std::string& world,
         Fmt("%.0f", Mean(particles)).c_str(), Fmt("%.1f", Mean(ms)).c_str());
   }
   std::printf(
-      "\nParticles alive (mean over seeds) after step:\n\n| "
-      "configuration |");
+      "\nParticles alive (mean over seeds) after step%s:\n\n| "
+      "configuration |",
+      o.kidnap_after > 0 ? " (counted from the start of the run)" : "");
   for (int k : kParticleSteps) std::printf(" %d |", k);
   std::printf("\n|---|");
   for (size_t k = 0; k < kParticleSteps.size(); ++k) std::printf("---|");
