@@ -74,6 +74,9 @@ struct SweepOptions {
   // MCC: least random particles injected per resampling (-1: the
   // localizer's default).
   int mcc_min_injected = -1;
+  // MCC: largest rotation a correction may make (degrees; <= 0: the
+  // localizer's default).
+  double mcc_max_rotation_deg = 0.0;
   // Kidnapped robot: carried off after this many updates (0: no kidnapping,
   // global initialisation instead) ...
   int kidnap_after = 0;
@@ -279,6 +282,9 @@ nlohmann::json RunSeed(const SweepOptions& o, const std::string& world,
     lo.kld.min_particles = std::min(lo.kld.min_particles, lo.num_particles);
     lo.seed = static_cast<uint64_t>(seed);
     if (o.mcc_min_injected >= 0) lo.mcc_min_injected = o.mcc_min_injected;
+    if (o.mcc_max_rotation_deg > 0) {
+      lo.mcc.max_rotation_deg = o.mcc_max_rotation_deg;
+    }
     std::vector<TimedPose> trajectory;
     const LocalizationReport r = LocalizeSequence(map, live, lo, &trajectory);
     ConfigRun& run = (*runs)[c];
@@ -507,6 +513,7 @@ int Run(const SweepOptions& o) {
       {"run_seed_base", o.run_seed_base},
       {"ba_threads", o.ba_threads},
       {"mcc_min_injected", o.mcc_min_injected},
+      {"mcc_max_rotation_deg", o.mcc_max_rotation_deg},
       {"max_translation_error_m", o.accuracy.max_translation_error_m},
       {"max_rotation_error_deg", o.accuracy.max_rotation_error_deg},
       {"state", "planar"},
@@ -575,6 +582,9 @@ int main(int argc, char** argv) {
   app.add_option("--mcc-min-injected", o.mcc_min_injected,
                  "MCC: least random particles injected per resampling "
                  "(-1: the localizer's default)");
+  app.add_option("--mcc-max-rotation-deg", o.mcc_max_rotation_deg,
+                 "MCC: largest rotation of a correction (degrees; 0: the "
+                 "localizer's default)");
   app.add_option("--kidnap-after", o.kidnap_after,
                  "Start at the true pose and carry the robot off after this "
                  "many updates (0: global initialisation instead)");
