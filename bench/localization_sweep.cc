@@ -77,6 +77,11 @@ struct SweepOptions {
   // MCC: largest rotation a correction may make (degrees; <= 0: the
   // localizer's default).
   double mcc_max_rotation_deg = 0.0;
+  // Relocalization trigger (LocalizerOptions::relocalize_*; a negative
+  // value: the localizer's default).
+  double relocalize_drop = -1.0;
+  double relocalize_fraction = -1.0;
+  double relocalize_alpha_slow = -1.0;
   // Kidnapped robot: carried off after this many updates (0: no kidnapping,
   // global initialisation instead) ...
   int kidnap_after = 0;
@@ -285,6 +290,13 @@ nlohmann::json RunSeed(const SweepOptions& o, const std::string& world,
     if (o.mcc_max_rotation_deg > 0) {
       lo.mcc.max_rotation_deg = o.mcc_max_rotation_deg;
     }
+    if (o.relocalize_drop >= 0) lo.relocalize_drop = o.relocalize_drop;
+    if (o.relocalize_fraction >= 0) {
+      lo.relocalize_fraction = o.relocalize_fraction;
+    }
+    if (o.relocalize_alpha_slow >= 0) {
+      lo.relocalize_alpha_slow = o.relocalize_alpha_slow;
+    }
     std::vector<TimedPose> trajectory;
     const LocalizationReport r = LocalizeSequence(map, live, lo, &trajectory);
     ConfigRun& run = (*runs)[c];
@@ -311,7 +323,8 @@ nlohmann::json RunSeed(const SweepOptions& o, const std::string& world,
                    steps_weighed = nlohmann::json::array(),
                    steps_ms = nlohmann::json::array(),
                    steps_ncc = nlohmann::json::array(),
-                   steps_cluster = nlohmann::json::array();
+                   steps_cluster = nlohmann::json::array(),
+                   steps_injected = nlohmann::json::array();
     for (const LocalizerStepStats& s : r.steps) {
       run.particles.push_back(s.particles);
       steps_particles.push_back(s.particles);
@@ -319,6 +332,7 @@ nlohmann::json RunSeed(const SweepOptions& o, const std::string& world,
       steps_ms.push_back(1e3 * s.seconds);
       steps_ncc.push_back(s.best_ncc);
       steps_cluster.push_back(s.cluster_weight);
+      steps_injected.push_back(s.injected);
     }
     // Camera positions (x, y) and heading of the optical axis per step.
     nlohmann::json est_xy = nlohmann::json::array(),
@@ -355,7 +369,8 @@ nlohmann::json RunSeed(const SweepOptions& o, const std::string& world,
         {"weighed_per_step", steps_weighed},
         {"ms_per_step", steps_ms},
         {"best_ncc_per_step", steps_ncc},
-        {"cluster_weight_per_step", steps_cluster}};
+        {"cluster_weight_per_step", steps_cluster},
+        {"injected_per_step", steps_injected}};
     std::fprintf(
         stderr, " %s %s (%s, %.1f cm)", configs[c].name.c_str(),
         run.accuracy.success ? "ok" : "FAIL",
@@ -514,6 +529,9 @@ int Run(const SweepOptions& o) {
       {"ba_threads", o.ba_threads},
       {"mcc_min_injected", o.mcc_min_injected},
       {"mcc_max_rotation_deg", o.mcc_max_rotation_deg},
+      {"relocalize_drop", o.relocalize_drop},
+      {"relocalize_fraction", o.relocalize_fraction},
+      {"relocalize_alpha_slow", o.relocalize_alpha_slow},
       {"max_translation_error_m", o.accuracy.max_translation_error_m},
       {"max_rotation_error_deg", o.accuracy.max_rotation_error_deg},
       {"state", "planar"},
@@ -585,6 +603,15 @@ int main(int argc, char** argv) {
   app.add_option("--mcc-max-rotation-deg", o.mcc_max_rotation_deg,
                  "MCC: largest rotation of a correction (degrees; 0: the "
                  "localizer's default)");
+  app.add_option("--relocalize-drop", o.relocalize_drop,
+                 "Relocalization trigger: drop of the best log-likelihood "
+                 "(0: off; negative: the localizer's default)");
+  app.add_option("--relocalize-fraction", o.relocalize_fraction,
+                 "Share of the budget injected while relocalizing "
+                 "(negative: the localizer's default)");
+  app.add_option("--relocalize-alpha-slow", o.relocalize_alpha_slow,
+                 "Weight of the newest update in the slow average "
+                 "(negative: the localizer's default)");
   app.add_option("--kidnap-after", o.kidnap_after,
                  "Start at the true pose and carry the robot off after this "
                  "many updates (0: global initialisation instead)");

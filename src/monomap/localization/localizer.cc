@@ -1,10 +1,11 @@
 #include "monomap/localization/localizer.h"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
-
-#include <tbb/parallel_for.h>
 
 #include "monomap/util/error.h"
 #include "monomap/util/progress.h"
@@ -60,6 +61,14 @@ void LocalizerOptions::Check() const {
               "must be in [0, 1]");
   CheckOption(max_injection_fraction >= 0 && max_injection_fraction < 1,
               "max_injection_fraction", "must be in [0, 1)");
+  CheckOption(relocalize_drop >= 0, "relocalize_drop", "must be >= 0");
+  CheckOption(relocalize_fraction >= 0 && relocalize_fraction < 1,
+              "relocalize_fraction", "must be in [0, 1)");
+  CheckOption(relocalize_alpha_fast > 0 && relocalize_alpha_fast <= 1,
+              "relocalize_alpha_fast", "must be in (0, 1]");
+  CheckOption(relocalize_alpha_slow > 0 &&
+                  relocalize_alpha_slow < relocalize_alpha_fast,
+              "relocalize_alpha_slow", "must be in (0, relocalize_alpha_fast)");
   CheckOption(init_spread_m >= 0, "init_spread_m", "must be >= 0");
   CheckOption(init_spread_deg >= 0, "init_spread_deg", "must be >= 0");
   CheckOption(area_margin_m >= 0, "area_margin_m", "must be >= 0");
@@ -173,6 +182,7 @@ void Localizer::InitializeGlobal(const std::optional<Rigid3d>& reference) {
   }
   first_step_ = true;
   w_slow_ = w_fast_ = 0.0;
+  has_best_average_ = false;
 }
 
 void Localizer::InitializeAtPose(const Rigid3d& world_from_cam) {
@@ -207,6 +217,7 @@ void Localizer::InitializeAtPose(const Rigid3d& world_from_cam) {
   }
   first_step_ = true;
   w_slow_ = w_fast_ = 0.0;
+  has_best_average_ = false;
 }
 
 void Localizer::Initialize(const std::optional<Rigid3d>& pose) {
@@ -352,6 +363,27 @@ LocalizerEstimate Localizer::Step(const cv::Mat& live_image_raw,
     }
   }
 
+  // Relocalization: fast and slow averages of the best log-likelihood.
+  int n_relocalize = 0;
+  if (options_.relocalize_drop > 0) {
+    double best_log = -std::numeric_limits<double>::infinity();
+    for (const MeasurementScore& s : scores) {
+      best_log = std::max(best_log, s.log_likelihood);
+    }
+    if (!has_best_average_) {
+      best_fast_ = best_slow_ = best_log;
+      has_best_average_ = true;
+    } else {
+      best_fast_ += options_.relocalize_alpha_fast * (best_log - best_fast_);
+      best_slow_ += options_.relocalize_alpha_slow * (best_log - best_slow_);
+    }
+    if (best_fast_ < best_slow_ - options_.relocalize_drop) {
+      stats.relocalizing = true;
+      n_relocalize = static_cast<int>(
+          std::lround(options_.relocalize_fraction * options_.num_particles));
+    }
+  }
+
   // Resample.
   if (stats.ess < options_.resample_ess_fraction * particles_.size() + 1e-9) {
     std::vector<int> idx;
@@ -377,7 +409,16 @@ LocalizerEstimate Localizer::Step(const cv::Mat& live_image_raw,
     }
     std::uniform_int_distribution<size_t> pick(0, next.size() - 1);
     for (int i = 0; i < n_inject; ++i) next[pick(rng_)] = RandomParticle();
-    stats.injected = n_inject;
+    // Relocalization adds to the set up to the budget, and replaces
+    // (at most half of the set) beyond it.
+    const int n_append = std::min(
+        n_relocalize,
+        std::max(0, options_.num_particles - static_cast<int>(next.size())));
+    const int n_replace =
+        std::min(n_relocalize - n_append, static_cast<int>(next.size()) / 2);
+    for (int i = 0; i < n_replace; ++i) next[pick(rng_)] = RandomParticle();
+    for (int i = 0; i < n_append; ++i) next.push_back(RandomParticle());
+    stats.injected = n_inject + n_replace + n_append;
     particles_ = std::move(next);
     stats.resampled = true;
     if (options_.method == LocalizationMethod::kMcc) {

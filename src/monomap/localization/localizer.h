@@ -99,6 +99,21 @@ struct LocalizerOptions {
   double alpha_slow = 0.0;
   double alpha_fast = 0.0;
   double max_injection_fraction = 0.2;
+  // Relocalization. MCC merges the set down to a handful of particles, so
+  // injection sized by the set (above) stays at a few particles even when
+  // the filter is lost. Here a loss is detected from the best particle's
+  // log-likelihood: when its fast average falls more than relocalize_drop
+  // below its slow average, relocalize_fraction of the particle budget
+  // (num_particles) is injected over the area at each resampling, until
+  // the drop is found (the fast average rises) or becomes the norm (the
+  // slow one falls). The best particle, not the mean, so that the injected
+  // particles themselves do not lower the signal. 0: off.
+  double relocalize_drop = 0.0;
+  // Share of the budget injected per resampling while relocalizing.
+  double relocalize_fraction = 0.1;
+  // Smoothing of the fast and slow averages (weight of the newest update).
+  double relocalize_alpha_fast = 0.5;
+  double relocalize_alpha_slow = 0.01;
   // Pose init: standard deviations of the spread (m, degrees); with the
   // 6-DoF state they apply per axis.
   double init_spread_m = 0.05;
@@ -136,6 +151,7 @@ struct LocalizerStepStats {
   double cluster_weight = 0.0;  // weight share of the estimate's cluster
   int kld_bins = 0;
   int injected = 0;
+  bool relocalizing = false;  // relocalize_drop was exceeded this update
   int mcc_attempted = 0;
   int mcc_accepted = 0;
   int merged = 0;
@@ -199,6 +215,10 @@ class Localizer {
   bool has_reference_ = false;
   bool first_step_ = true;
   double w_slow_ = 0.0, w_fast_ = 0.0;
+  // Relocalization: averages of the best log-likelihood (valid once
+  // has_best_average_).
+  bool has_best_average_ = false;
+  double best_fast_ = 0.0, best_slow_ = 0.0;
   Rng rng_;
 };
 

@@ -293,6 +293,64 @@ TEST_F(LocalizerTest, MccRecoversFromAKidnappingByInjection) {
   EXPECT_LT(recovered.back(), 0.01);
 }
 
+// Kidnapped while tracking: the filter holds the pose for 10 updates, then
+// the robot is carried 0.4 m to the left and turned 90 degrees while the
+// odometry goes on as if nothing happened. Without any random particles
+// MCC stays with the old pose; the relocalization trigger notices the drop
+// of the best likelihood and injects 10 % of the budget per resampling
+// until an injected particle, corrected, finds the truth. It must stay
+// quiet while the filter tracks, before the jump and after recovering.
+TEST_F(LocalizerTest, RelocalizationRecoversFromAKidnappingWhileTracking) {
+  constexpr int kJump = 10;
+  Drive drive = MakeDrive({0.3, 0.1, 0.3}, 45, 0.02, 1.0 * kDeg, 9);
+  // The same motion after the jump: the truth is moved by a world-frame
+  // transform, which leaves its increments (the odometry's) unchanged.
+  const Pose2d t = drive.truth[kJump];
+  const Pose2d t_inv = {-(std::cos(t.yaw) * t.x + std::sin(t.yaw) * t.y),
+                        std::sin(t.yaw) * t.x - std::cos(t.yaw) * t.y, -t.yaw};
+  const auto mul = [](const Pose2d& a, const Pose2d& b) {
+    return Compose(a, b.x, b.y, b.yaw);
+  };
+  const Pose2d move = mul(Compose(t, 0.0, 0.4, 90.0 * kDeg), t_inv);
+  for (size_t i = kJump; i < drive.truth.size(); ++i) {
+    drive.truth[i] = mul(move, drive.truth[i]);
+  }
+  auto run = [&](double drop, std::vector<LocalizerStepStats>* stats) {
+    LocalizerOptions o = PlanarOverUnitArea(LocalizationMethod::kMcc, 200, 50);
+    o.init_spread_m = 0.01;
+    o.init_spread_deg = 1.0;
+    o.injection_fraction = 0.0;
+    o.mcc_min_injected = 0;
+    o.relocalize_drop = drop;
+    o.seed = 3;
+    Localizer loc(map(), camera(), o, mount());
+    loc.InitializeAtPose(WorldFromCamOfBase(drive.truth[0], mount()));
+    return Run(drive, &loc, stats);
+  };
+  std::vector<LocalizerStepStats> off_stats, on_stats;
+  const std::vector<double> stuck = run(0.0, &off_stats);
+  const std::vector<double> recovered = run(1.0, &on_stats);
+  std::string fired;
+  for (const LocalizerStepStats& s : on_stats)
+    fired += s.relocalizing ? '1' : '0';
+  std::printf(
+      "kidnapped while tracking: before the jump %.3f m; last "
+      "without relocalization %.3f m, with %.3f m; relocalizing "
+      "%s\n",
+      Max(std::vector<double>(stuck.begin(), stuck.begin() + kJump)),
+      stuck.back(), recovered.back(), fired.c_str());
+  EXPECT_LT(
+      Max(std::vector<double>(recovered.begin(), recovered.begin() + kJump)),
+      0.01);
+  EXPECT_GT(stuck.back(), 0.2);
+  EXPECT_LT(recovered.back(), 0.01);
+  // Quiet before the jump and over the last 10 updates; fired after it.
+  EXPECT_EQ(fired.find('1'), fired.find('1', kJump));
+  EXPECT_EQ(fired.substr(fired.size() - 10), std::string(10, '0'));
+  EXPECT_GT(std::count(fired.begin(), fired.end(), '1'), 0);
+  for (const LocalizerStepStats& s : off_stats) EXPECT_FALSE(s.relocalizing);
+}
+
 TEST_F(LocalizerTest, LocalizeSequenceReadsADataset) {
   const std::filesystem::path dir =
       std::filesystem::temp_directory_path() /
