@@ -55,6 +55,8 @@ struct SweepOptions {
   std::vector<std::string> worlds = {"hallway", "room"};
   int seeds = 20;
   int first_seed = 1;
+  // Kidnap mode adds kidnap_skip to both runs, so that the map still
+  // covers the whole (longer) localization traversal.
   int map_frames = 200;
   int loc_frames = 120;
   int width = 640;
@@ -214,7 +216,7 @@ nlohmann::json RunSeed(const SweepOptions& o, const std::string& world,
   // 1. The mapping run and its map, from images and odometry only.
   Timer timer;
   SimulationOptions sim = SimOptions(o, world, seed);
-  sim.num_frames = o.map_frames;
+  sim.num_frames = o.map_frames + (o.kidnap_after > 0 ? o.kidnap_skip : 0);
   const SimulationReport map_sim = Simulate(sim, map_data);
   const Dataset mapping = LoadDataset(map_data);
   const std::vector<TimedPose> mapping_truth = GroundTruth(mapping);
@@ -396,7 +398,9 @@ nlohmann::json Summarize(const SweepOptions& o, const std::string& world,
       "\n### %s: %d seeds (%d..%d), map %d frames, localization %d "
       "frames, %dx%d\n\n",
       world.c_str(), o.seeds, o.first_seed, o.first_seed + o.seeds - 1,
-      o.map_frames, o.loc_frames, o.width, o.height);
+      o.map_frames + (o.kidnap_after > 0 ? o.kidnap_skip : 0),
+      o.loc_frames + (o.kidnap_after > 0 ? o.kidnap_skip : 0), o.width,
+      o.height);
   if (o.kidnap_after > 0) {
     std::printf(
         "Kidnapped after update %d, %d frames ahead; the figures are those "
@@ -582,7 +586,8 @@ int main(int argc, char** argv) {
       ->delimiter(',');
   app.add_option("--seeds", o.seeds, "Number of seeds per world");
   app.add_option("--first-seed", o.first_seed, "First seed");
-  app.add_option("--map-frames", o.map_frames, "Frames of the mapping run");
+  app.add_option("--map-frames", o.map_frames,
+                 "Frames of the mapping run (kidnap mode: plus the skip)");
   app.add_option("--loc-frames", o.loc_frames,
                  "Frames of the localization run");
   app.add_option("--width", o.width, "Image width");

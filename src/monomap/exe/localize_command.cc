@@ -22,6 +22,7 @@ void RegisterLocalizeCommand(CLI::App& app) {
     int particles = 1000;
     std::string mcc_size, measure_size;
     int mcc_top_k = -1;
+    double relocalize_drop = -1.0;
     int first_frame = 0, num_frames = -1;
     uint64_t seed = 1;
   };
@@ -45,6 +46,10 @@ void RegisterLocalizeCommand(CLI::App& app) {
                   "WxH of the renders MCC tracks against (default 160x120)");
   cmd->add_option("--mcc-top-k", a->mcc_top_k,
                   "Heaviest particles MCC corrects per update (default 64)");
+  cmd->add_option("--relocalize-drop", a->relocalize_drop,
+                  "Inject particles over the area when the best "
+                  "log-likelihood drops this far below its long-term "
+                  "average (0: never; default: the localizer's)");
   cmd->add_option("--measure-size", a->measure_size,
                   "WxH of the renders the weights compare (default 80x60)");
   cmd->add_option("--camera", a->camera_yaml,
@@ -80,6 +85,7 @@ void RegisterLocalizeCommand(CLI::App& app) {
                      &options.measurement.width, &options.measurement.height);
     }
     if (a->mcc_top_k >= 0) options.mcc_top_k = a->mcc_top_k;
+    if (a->relocalize_drop >= 0) options.relocalize_drop = a->relocalize_drop;
     options.seed = a->seed;
     std::vector<TimedPose> trajectory;
     std::vector<std::vector<Particle>> sets;
@@ -121,6 +127,8 @@ void RegisterLocalizeCommand(CLI::App& app) {
                        {"best_ncc", s.best_ncc},
                        {"mcc_accepted", s.mcc_accepted},
                        {"merged", s.merged},
+                       {"injected", s.injected},
+                       {"relocalizing", s.relocalizing},
                        {"seconds", s.seconds}});
     }
     j["steps"] = steps;
