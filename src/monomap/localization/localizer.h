@@ -107,8 +107,11 @@ struct LocalizerOptions {
   // (num_particles) is injected over the area at each resampling, until
   // the drop is found (the fast average rises) or becomes the norm (the
   // slow one falls). The best particle, not the mean, so that the injected
-  // particles themselves do not lower the signal. 0: off.
-  double relocalize_drop = 0.0;
+  // particles themselves do not lower the signal. 0: off. 0.7 (an NCC
+  // drop of 0.035 at sigma 0.05) lies between tracking's fluctuations and
+  // a kidnapping's drop in the sweeps (docs/benchmarks.md, "Kidnapped
+  // robot with relocalization").
+  double relocalize_drop = 0.7;
   // Share of the budget injected per resampling while relocalizing.
   double relocalize_fraction = 0.1;
   // Smoothing of the fast and slow averages (weight of the newest update).

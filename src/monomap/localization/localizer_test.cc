@@ -277,6 +277,7 @@ TEST_F(LocalizerTest, MccRecoversFromAKidnappingByInjection) {
     o.init_spread_deg = 1.0;
     o.injection_fraction = 0.0;
     o.mcc_min_injected = min_injected;
+    o.relocalize_drop = 0.0;  // injection alone (see the test below)
     o.seed = 2;
     Localizer loc(map(), camera(), o, mount());
     loc.InitializeAtPose(WorldFromCamOfBase(
@@ -329,7 +330,8 @@ TEST_F(LocalizerTest, RelocalizationRecoversFromAKidnappingWhileTracking) {
   };
   std::vector<LocalizerStepStats> off_stats, on_stats;
   const std::vector<double> stuck = run(0.0, &off_stats);
-  const std::vector<double> recovered = run(1.0, &on_stats);
+  const std::vector<double> recovered =
+      run(LocalizerOptions().relocalize_drop, &on_stats);
   std::string fired;
   for (const LocalizerStepStats& s : on_stats)
     fired += s.relocalizing ? '1' : '0';
@@ -429,6 +431,12 @@ TEST(LocalizerOptions, CheckAndParse) {
   EXPECT_THROW(o.Check(), OptionsError);
   o = {};
   o.num_particles = 0;
+  EXPECT_THROW(o.Check(), OptionsError);
+  o = {};
+  o.relocalize_alpha_slow = o.relocalize_alpha_fast;  // slow must be slower
+  EXPECT_THROW(o.Check(), OptionsError);
+  o = {};
+  o.relocalize_drop = -1.0;
   EXPECT_THROW(o.Check(), OptionsError);
   EXPECT_EQ(ParseLocalizationMethod("mcc"), LocalizationMethod::kMcc);
   EXPECT_EQ(ParseLocalizationState("6dof"), LocalizationState::k6Dof);
