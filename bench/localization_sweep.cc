@@ -189,6 +189,11 @@ Dataset Kidnap(const Dataset& d, int after, int skip) {
   return out;
 }
 
+// Frames the kidnapping adds to both runs (the jump skips them).
+int KidnapFrames(const SweepOptions& o) {
+  return o.kidnap_after > 0 ? o.kidnap_skip : 0;
+}
+
 SimulationOptions SimOptions(const SweepOptions& o, const std::string& world,
                              int seed) {
   SimulationOptions sim;
@@ -216,7 +221,7 @@ nlohmann::json RunSeed(const SweepOptions& o, const std::string& world,
   // 1. The mapping run and its map, from images and odometry only.
   Timer timer;
   SimulationOptions sim = SimOptions(o, world, seed);
-  sim.num_frames = o.map_frames + (o.kidnap_after > 0 ? o.kidnap_skip : 0);
+  sim.num_frames = o.map_frames + KidnapFrames(o);
   const SimulationReport map_sim = Simulate(sim, map_data);
   const Dataset mapping = LoadDataset(map_data);
   const std::vector<TimedPose> mapping_truth = GroundTruth(mapping);
@@ -246,7 +251,7 @@ nlohmann::json RunSeed(const SweepOptions& o, const std::string& world,
   // 2. The localization run: the same world, another traversal.
   timer.Restart();
   const bool kidnap = o.kidnap_after > 0;
-  sim.num_frames = o.loc_frames + (kidnap ? o.kidnap_skip : 0);
+  sim.num_frames = o.loc_frames + KidnapFrames(o);
   sim.run_seed = o.run_seed_base + static_cast<uint64_t>(seed);
   sim.path.start_offset_m = o.start_offset_m;
   sim.path.lateral_offset_m = o.lateral_offset_m;
@@ -398,8 +403,7 @@ nlohmann::json Summarize(const SweepOptions& o, const std::string& world,
       "\n### %s: %d seeds (%d..%d), map %d frames, localization %d "
       "frames, %dx%d\n\n",
       world.c_str(), o.seeds, o.first_seed, o.first_seed + o.seeds - 1,
-      o.map_frames + (o.kidnap_after > 0 ? o.kidnap_skip : 0),
-      o.loc_frames + (o.kidnap_after > 0 ? o.kidnap_skip : 0), o.width,
+      o.map_frames + KidnapFrames(o), o.loc_frames + KidnapFrames(o), o.width,
       o.height);
   if (o.kidnap_after > 0) {
     std::printf(
