@@ -13,6 +13,7 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <sstream>
 #include <string>
 
 #include "monomap/geometry/polygon.h"
@@ -398,7 +399,8 @@ TEST_F(Cli, EvalRenderComparesHeldOutFrames) {
 }
 
 // Localization end to end through the binary: a map of the 40 frames,
-// the same frames localized from their first true pose (planar MCC), the
+// the same frames localized from their first odometry pose (planar MCC;
+// the simulated odometry starts at the true pose), the
 // trajectory, report and particle sets written, errors in centimetres.
 TEST_F(Cli, LocalizeTracksTheDatasetInItsMap) {
   const fs::path data = *root_ / "data";
@@ -455,6 +457,40 @@ TEST_F(Cli, LocalizeTracksTheDatasetInItsMap) {
                 .exit_code,
             2);
   EXPECT_FALSE(fs::exists(*root_ / "x.txt"));
+  // An explicit start pose: the first ground-truth line, moved 0.3 m.
+  // Started there, MCL is off by about that much after one update (the run
+  // above started at the first odometry pose, here the true one).
+  std::ifstream gt_in(data / "groundtruth.txt");
+  std::string line;
+  while (std::getline(gt_in, line) && (line.empty() || line[0] == '#')) {
+  }
+  std::istringstream fields(line);
+  double stamp, tx, ty, tz, qx, qy, qz, qw;
+  ASSERT_TRUE(fields >> stamp >> tx >> ty >> tz >> qx >> qy >> qz >> qw);
+  char pose[200];
+  std::snprintf(pose, sizeof(pose), "%.6f %.6f %.6f %.9f %.9f %.9f %.9f",
+                tx + 0.3, ty, tz, qx, qy, qz, qw);
+  const fs::path moved = *root_ / "moved.json";
+  r = RunMonomap("localize " + map.string() + " " + data.string() +
+                 " --method mcl --frames 1 --particles 100 --init-pose \"" +
+                 pose + "\" -o " + (*root_ / "moved.txt").string() +
+                 " --report " + moved.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::ifstream moved_in(moved);
+  const nlohmann::json mj = nlohmann::json::parse(moved_in);
+  EXPECT_GT(mj["final_translation_error_m"].get<double>(), 0.15);
+  // --init-pose is for --init pose only; a malformed pose is named.
+  r = RunMonomap("localize " + map.string() + " " + data.string() +
+                 " --init global --init-pose \"" + pose + "\" -o " +
+                 (*root_ / "x.txt").string());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--init-pose"), std::string::npos) << r.output;
+  r = RunMonomap("localize " + map.string() + " " + data.string() +
+                 " --init-pose \"1 2 3\" -o " + (*root_ / "x.txt").string());
+  EXPECT_NE(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("--init-pose"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(*root_ / "x.txt"));
+
   // The planar state without 2D odometry names the file it needs.
   const fs::path no2d = CopyData("data_no_odometry2d");
   fs::remove(no2d / "odometry2d.txt");

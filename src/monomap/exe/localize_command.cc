@@ -1,5 +1,6 @@
 // monomap localize MAP_DIR DATASET --method mcl|mcc [--particles N]
-//   [--init global|pose] [--state planar|6dof] -o TRAJ.txt [--report R.json]
+//   [--init global|pose [--init-pose POSE]] [--state planar|6dof] -o TRAJ.txt
+//   [--report R.json]
 #include <algorithm>
 #include <cstdio>
 #include <memory>
@@ -11,6 +12,7 @@
 #include "monomap/io/map_format.h"
 #include "monomap/io/trajectory_io.h"
 #include "monomap/localization/localizer.h"
+#include "monomap/util/error.h"
 #include "monomap/util/file.h"
 
 namespace monomap {
@@ -18,6 +20,7 @@ namespace monomap {
 void RegisterLocalizeCommand(CLI::App& app) {
   struct Args {
     std::string map_dir, dataset, output, report, particles_out, camera_yaml;
+    std::string init_pose;
     std::string method = "mcl", init = "pose", state = "planar";
     int particles = 1000;
     std::string mcc_size, measure_size;
@@ -37,6 +40,10 @@ void RegisterLocalizeCommand(CLI::App& app) {
       ->check(CLI::IsMember({"mcl", "mcc"}));
   cmd->add_option("--init", a->init, "global | pose")
       ->check(CLI::IsMember({"global", "pose"}));
+  cmd->add_option("--init-pose", a->init_pose,
+                  "With --init pose: the pose T_world_cam to start around, "
+                  "as \"tx ty tz qx qy qz qw\" (default: the first frame's "
+                  "odometry pose)");
   cmd->add_option("--state", a->state, "planar | 6dof")
       ->check(CLI::IsMember({"planar", "6dof"}));
   cmd->add_option("--particles", a->particles,
@@ -71,6 +78,12 @@ void RegisterLocalizeCommand(CLI::App& app) {
     options.method = ParseLocalizationMethod(a->method);
     options.init = ParseLocalizationInit(a->init);
     options.state = ParseLocalizationState(a->state);
+    if (!a->init_pose.empty()) {
+      if (options.init != LocalizationInit::kPose) {
+        throw OptionsError("--init-pose needs --init pose");
+      }
+      options.init_pose = ParsePose(a->init_pose, "--init-pose");
+    }
     // The budget: the initial count and KLD-sampling's maximum.
     options.num_particles = a->particles;
     options.kld.max_particles = a->particles;

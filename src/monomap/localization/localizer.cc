@@ -55,12 +55,6 @@ void LocalizerOptions::Check() const {
   CheckOption(injection_fraction >= 0 && injection_fraction < 1,
               "injection_fraction", "must be in [0, 1)");
   CheckOption(mcc_min_injected >= 0, "mcc_min_injected", "must be >= 0");
-  CheckOption(alpha_slow >= 0 && alpha_slow <= 1, "alpha_slow",
-              "must be in [0, 1]");
-  CheckOption(alpha_fast >= 0 && alpha_fast <= 1, "alpha_fast",
-              "must be in [0, 1]");
-  CheckOption(max_injection_fraction >= 0 && max_injection_fraction < 1,
-              "max_injection_fraction", "must be in [0, 1)");
   CheckOption(relocalize_drop >= 0, "relocalize_drop", "must be >= 0");
   CheckOption(relocalize_fraction >= 0 && relocalize_fraction < 1,
               "relocalize_fraction", "must be in [0, 1)");
@@ -181,7 +175,6 @@ void Localizer::InitializeGlobal(const std::optional<Rigid3d>& reference) {
     particles_.push_back(RandomParticle());
   }
   first_step_ = true;
-  w_slow_ = w_fast_ = 0.0;
   has_best_average_ = false;
 }
 
@@ -216,7 +209,6 @@ void Localizer::InitializeAtPose(const Rigid3d& world_from_cam) {
     particles_.push_back(p);
   }
   first_step_ = true;
-  w_slow_ = w_fast_ = 0.0;
   has_best_average_ = false;
 }
 
@@ -267,12 +259,9 @@ LocalizerEstimate Localizer::Step(const cv::Mat& live_image_raw,
   std::vector<MeasurementScore> scores =
       measurement_.ScoreBatch(live_small, poses);
   stats.particles_weighed = static_cast<int>(particles_.size());
-  double mean_likelihood = 0.0;
   for (size_t i = 0; i < particles_.size(); ++i) {
     particles_[i].log_weight += scores[i].log_likelihood;
-    mean_likelihood += std::exp(scores[i].log_likelihood);
   }
-  mean_likelihood /= particles_.size();
   stats.weigh_seconds = weigh_timer.ElapsedSeconds();
 
   // Correct the heaviest particles (before resampling, so that resampling
@@ -348,21 +337,6 @@ LocalizerEstimate Localizer::Step(const cv::Mat& live_image_raw,
     stats.mcc_seconds += refine_timer.ElapsedSeconds();
   }
 
-  // Augmented MCL: long- and short-term averages of the likelihood.
-  double injection = options_.injection_fraction;
-  if (options_.alpha_slow > 0 && options_.alpha_fast > options_.alpha_slow) {
-    if (w_slow_ == 0.0) {
-      w_slow_ = w_fast_ = mean_likelihood;
-    } else {
-      w_slow_ += options_.alpha_slow * (mean_likelihood - w_slow_);
-      w_fast_ += options_.alpha_fast * (mean_likelihood - w_fast_);
-    }
-    if (w_slow_ > 0) {
-      injection = std::min(options_.max_injection_fraction,
-                           std::max(injection, 1.0 - w_fast_ / w_slow_));
-    }
-  }
-
   // Relocalization: fast and slow averages of the best log-likelihood.
   int n_relocalize = 0;
   if (options_.relocalize_drop > 0) {
@@ -399,7 +373,8 @@ LocalizerEstimate Localizer::Step(const cv::Mat& live_image_raw,
       next.push_back(particles_[i]);
       next.back().log_weight = 0.0;
     }
-    int n_inject = static_cast<int>(std::lround(injection * next.size()));
+    int n_inject = static_cast<int>(
+        std::lround(options_.injection_fraction * next.size()));
     if (options_.method == LocalizationMethod::kMcc) {
       // Never more than half the set: the resampled particles carry the
       // filter's belief.
@@ -461,9 +436,8 @@ LocalizationReport LocalizeSequence(
   const Timer timer;
   Localizer localizer(map, dataset.camera, options, dataset.base_from_cam);
   const DatasetFrame& first = dataset.frames.front();
-  const Rigid3d start = first.groundtruth_world_from_cam
-                            ? *first.groundtruth_world_from_cam
-                            : first.odometry_world_from_cam;
+  const Rigid3d start =
+      options.init_pose.value_or(first.odometry_world_from_cam);
   if (options.init == LocalizationInit::kGlobal) {
     localizer.InitializeGlobal(
         map.trajectory.empty() ? std::optional<Rigid3d>(

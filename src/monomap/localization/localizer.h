@@ -93,12 +93,6 @@ struct LocalizerOptions {
   // that outscore the truth: room, 20 seeds, MCC 3000 / 750 particles
   // succeeded 20 / 15 times with ~2, 20 / 17 with 4, 18 / 19 with 8.
   int mcc_min_injected = 4;
-  // Augmented MCL (Thrun et al. 8.3.5): if alpha_fast > alpha_slow > 0,
-  // injection uses max(injection_fraction, 1 - w_fast / w_slow) capped at
-  // max_injection_fraction.
-  double alpha_slow = 0.0;
-  double alpha_fast = 0.0;
-  double max_injection_fraction = 0.2;
   // Relocalization. MCC merges the set down to a handful of particles, so
   // injection sized by the set (above) stays at a few particles even when
   // the filter is lost. Here a loss is detected from the best particle's
@@ -117,6 +111,10 @@ struct LocalizerOptions {
   // Smoothing of the fast and slow averages (weight of the newest update).
   double relocalize_alpha_fast = 0.5;
   double relocalize_alpha_slow = 0.01;
+  // Pose init in LocalizeSequence: the pose (world_from_cam) the particles
+  // are spread around. Empty: the first frame's odometry pose, what a robot
+  // would know. Ground truth is never used.
+  std::optional<Rigid3d> init_pose;
   // Pose init: standard deviations of the spread (m, degrees); with the
   // 6-DoF state they apply per axis.
   double init_spread_m = 0.05;
@@ -217,7 +215,6 @@ class Localizer {
   Rigid3d global_reference_;
   bool has_reference_ = false;
   bool first_step_ = true;
-  double w_slow_ = 0.0, w_fast_ = 0.0;
   // Relocalization: averages of the best log-likelihood (valid once
   // has_best_average_).
   bool has_best_average_ = false;
@@ -245,10 +242,11 @@ struct LocalizationReport {
 
 // Runs the filter over the dataset's frames with its odometry increments
 // (odometry2d for the planar state, odometry.txt poses for 6-DoF).
-// Initialization with kPose starts at the first frame's groundtruth if the
-// dataset has it, else at its odometry pose. `trajectory` receives the
-// estimates; `particle_sets` (optional) every step's particles after the
-// update. Throws InputError if the dataset lacks what the state needs.
+// Initialization with kPose starts at options.init_pose, or else at the
+// first frame's odometry pose (never at its ground truth). `trajectory`
+// receives the estimates; `particle_sets` (optional) every step's particles
+// after the update. Throws InputError if the dataset lacks what the state
+// needs.
 LocalizationReport LocalizeSequence(
     const Map& map, const Dataset& dataset, const LocalizerOptions& options,
     std::vector<TimedPose>* trajectory,

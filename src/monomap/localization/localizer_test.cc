@@ -383,6 +383,36 @@ TEST_F(LocalizerTest, LocalizeSequenceReadsADataset) {
   o.kld.max_particles = 200;
   std::vector<TimedPose> trajectory;
   std::vector<std::vector<Particle>> sets;
+
+  // Without a start pose the filter starts at the first odometry pose, not
+  // at the ground truth. This drive's odometry has its own origin, 0.36 m
+  // and 11 degrees from the true start: the particles are spread around
+  // the origin, so none of them is near the truth after the first update
+  // (MCL without injection: nothing else moves them).
+  Dataset first = ds;
+  first.frames.resize(1);
+  LocalizerOptions plain = o;
+  plain.method = LocalizationMethod::kMcl;
+  plain.injection_fraction = 0.0;
+  plain.relocalize_drop = 0.0;
+  LocalizeSequence(map_, first, plain, &trajectory, &sets);
+  ASSERT_EQ(sets.size(), 1u);
+  const Eigen::Vector3d odometry_start =
+      WorldFromCamOfBase(drive.odometry[0], mount_).translation;
+  const Eigen::Vector3d true_start =
+      WorldFromCamOfBase(drive.truth[0], mount_).translation;
+  double nearest_to_truth = 1e9, farthest_from_odometry = 0.0;
+  for (const Particle& p : sets[0]) {
+    const Eigen::Vector3d& t = p.world_from_cam.translation;
+    nearest_to_truth = std::min(nearest_to_truth, (t - true_start).norm());
+    farthest_from_odometry =
+        std::max(farthest_from_odometry, (t - odometry_start).norm());
+  }
+  EXPECT_LT(farthest_from_odometry, 0.3);
+  EXPECT_GT(nearest_to_truth, 0.1);
+
+  // Started at the true pose (init_pose), it tracks.
+  o.init_pose = WorldFromCamOfBase(drive.truth[0], mount_);
   const LocalizationReport r = LocalizeSequence(map_, ds, o, &trajectory,
                                                 &sets);
   std::filesystem::remove_all(dir);
