@@ -73,6 +73,9 @@ struct SweepOptions {
   // bit-reproducible (the map then differs in the last digits from run to
   // run, which is enough to flip some global-localization outcomes).
   int ba_threads = 1;
+  // Likelihood temperature of the measurement model (<= 0: the
+  // localizer's default).
+  double sigma = 0.0;
   // MCC: least random particles injected per resampling (-1: the
   // localizer's default).
   int mcc_min_injected = -1;
@@ -293,6 +296,7 @@ nlohmann::json RunSeed(const SweepOptions& o, const std::string& world,
     lo.kld.max_particles = configs[c].particles;
     lo.kld.min_particles = std::min(lo.kld.min_particles, lo.num_particles);
     lo.seed = static_cast<uint64_t>(seed);
+    if (o.sigma > 0) lo.measurement.sigma = o.sigma;
     if (o.mcc_min_injected >= 0) lo.mcc_min_injected = o.mcc_min_injected;
     if (o.mcc_max_rotation_deg > 0) {
       lo.mcc.max_rotation_deg = o.mcc_max_rotation_deg;
@@ -536,6 +540,7 @@ int Run(const SweepOptions& o) {
       {"run_seed_base", o.run_seed_base},
       {"ba_threads", o.ba_threads},
       {"mcc_min_injected", o.mcc_min_injected},
+      {"sigma", o.sigma},
       {"mcc_max_rotation_deg", o.mcc_max_rotation_deg},
       {"relocalize_drop", o.relocalize_drop},
       {"relocalize_fraction", o.relocalize_fraction},
@@ -606,6 +611,9 @@ int main(int argc, char** argv) {
                  "Lateral offset of the localization run (m, left)");
   app.add_option("--ba-threads", o.ba_threads,
                  "Bundle adjustment threads (1: bit-reproducible maps)");
+  app.add_option("--sigma", o.sigma,
+                 "Likelihood temperature of the measurement model (0: the "
+                 "localizer's default)");
   app.add_option("--mcc-min-injected", o.mcc_min_injected,
                  "MCC: least random particles injected per resampling "
                  "(-1: the localizer's default)");
