@@ -4,13 +4,26 @@
 // single-threaded and with tbb::parallel_for (Renderer::RenderBatch).
 //
 //   build/bench/rendering_bench --benchmark_counters_tabular=true
+//
+// Built maps too: MONOMAP_BENCH_MAPS=DIR[,DIR...] adds the same runs on
+// each map directory (e.g. one built from desk_vamr_a), with the map's own
+// intrinsics scaled to each size (stretched to 4:3 as the localizer's
+// renders are) and 1000 poses along its trajectory, each
+// moved by up to 2 cm and 2 degrees, as a particle set around the robot.
+#include <benchmark/benchmark.h>
+
 #include <cmath>
+#include <cstdlib>
+#include <exception>
+#include <memory>
+#include <opencv2/imgproc.hpp>
+#include <sstream>
+#include <string>
 #include <vector>
 
-#include <benchmark/benchmark.h>
-#include <opencv2/imgproc.hpp>
-
+#include "monomap/io/map_format.h"
 #include "monomap/rendering/renderer.h"
+#include "monomap/util/error.h"
 
 namespace monomap {
 namespace {
@@ -175,6 +188,105 @@ BENCHMARK(BM_Render)
     ->ArgsProduct({{0, 1}, {80, 160, 640}, {0, 1}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
+
+// A built map and poses around its trajectory.
+struct MapScene {
+  std::unique_ptr<Renderer> renderer;
+  Camera camera;
+  std::vector<Rigid3d> poses;
+};
+
+MapScene LoadMapScene(const std::string& dir) {
+  const Map map = ReadMap(dir);
+  if (map.trajectory.empty()) {
+    throw InputError(dir + ": the map has no trajectory to render around");
+  }
+  MapScene scene;
+  scene.renderer = std::make_unique<Renderer>(map);
+  scene.camera = map.camera.Pinhole();
+  cv::RNG rng(13);
+  for (int i = 0; i < kBatch; ++i) {
+    const Rigid3d& at =
+        map.trajectory[i % map.trajectory.size()].world_from_cam;
+    const Vector3d shift(rng.uniform(-0.02, 0.02), rng.uniform(-0.02, 0.02),
+                         rng.uniform(-0.02, 0.02));
+    const Vector3d axis =
+        Vector3d(rng.gaussian(1), rng.gaussian(1), rng.gaussian(1))
+            .normalized();
+    const double angle = rng.uniform(0.0, 2.0) * M_PI / 180.0;
+    scene.poses.emplace_back(
+        at.rotation * Eigen::Quaterniond(Eigen::AngleAxisd(angle, axis)),
+        at.translation + shift);
+  }
+  return scene;
+}
+
+// Args: render width (4:3), parallel (0/1).
+void BM_RenderMap(benchmark::State& state, const std::string& dir) {
+  static std::vector<std::pair<std::string, MapScene>> cache;
+  const MapScene* scene = nullptr;
+  for (const auto& [d, s] : cache) {
+    if (d == dir) scene = &s;
+  }
+  if (scene == nullptr) {
+    try {
+      cache.emplace_back(dir, LoadMapScene(dir));
+    } catch (const std::exception& e) {
+      state.SkipWithError(e.what());
+      for (auto _ : state) {
+      }
+      return;
+    }
+    scene = &cache.back().second;
+  }
+  const int width = static_cast<int>(state.range(0));
+  const bool parallel = state.range(1) != 0;
+  // 4:3 whatever the map camera's aspect, as the localizer's renders.
+  const int height = width * 3 / 4;
+  const Camera camera = scene->camera.Scaled(width, height);
+  std::vector<cv::Mat> greys(kBatch);
+  cv::Mat grey;
+  double foreground = 0;
+  for (auto _ : state) {
+    foreground = 0;
+    if (parallel) {
+      for (const RenderStats& s :
+           scene->renderer->RenderBatch(camera, scene->poses, &greys)) {
+        foreground += static_cast<double>(s.pixels_foreground) / s.pixels_total;
+      }
+    } else {
+      for (const Rigid3d& pose : scene->poses) {
+        const RenderStats s = scene->renderer->Render(camera, pose, &grey);
+        foreground += static_cast<double>(s.pixels_foreground) / s.pixels_total;
+      }
+    }
+    benchmark::ClobberMemory();
+  }
+  state.counters["renders_per_s"] =
+      benchmark::Counter(static_cast<double>(kBatch) * state.iterations(),
+                         benchmark::Counter::kIsRate);
+  state.counters["foreground"] = foreground / kBatch;
+  state.SetLabel(dir + " " + std::to_string(width) + "x" +
+                 std::to_string(height) + (parallel ? " tbb" : " 1-thread"));
+}
+
+// Registered before main() runs the benchmarks; the maps load on first use.
+const bool kMapsRegistered = [] {
+  const char* env = std::getenv("MONOMAP_BENCH_MAPS");
+  if (env == nullptr) return false;
+  std::stringstream list(env);
+  std::string dir;
+  while (std::getline(list, dir, ',')) {
+    if (dir.empty()) continue;
+    benchmark::RegisterBenchmark(("BM_RenderMap/" + dir).c_str(), BM_RenderMap,
+                                 dir)
+        ->ArgNames({"width", "parallel"})
+        ->ArgsProduct({{80, 160, 640}, {0, 1}})
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime();
+  }
+  return true;
+}();
 
 }  // namespace
 }  // namespace monomap
