@@ -385,6 +385,15 @@ TEST_F(Cli, EvalRenderComparesHeldOutFrames) {
   EXPECT_GT(j["ncc"]["median"].get<double>(), 0.8);
   EXPECT_GT(j["psnr_db"]["median"].get<double>(), 18.0);
   EXPECT_EQ(j["frames"][0]["frame"].get<int>(), 30);
+  // From poses 5 cm off (the default --wrong-offset) the images match
+  // clearly worse, in every frame (measured: NCC median 0.64 against 0.95).
+  const nlohmann::json& wrong = j["wrong_pose"];
+  EXPECT_DOUBLE_EQ(wrong["offset_m"].get<double>(), 0.05);
+  EXPECT_GE(wrong["compared"].get<int>(), 3);
+  EXPECT_DOUBLE_EQ(wrong["true_pose_better"].get<double>(), 1.0);
+  EXPECT_LT(wrong["ncc"]["median"].get<double>(),
+            j["ncc"]["median"].get<double>() - 0.1)
+      << wrong.dump();
 
   // No ground truth: the dataset is named, exit 1.
   const fs::path blind = CopyData("data_no_gt");

@@ -6,7 +6,8 @@
 // monomap eval lens MAP_DIR [--trajectory REF.txt]
 // monomap eval structure MAP_DIR --structure STRUCTURE_DIR
 //     [--align none|first-pose --groundtruth GT.txt]
-// monomap eval render MAP_DIR DATASET [--stride N] [--width W]
+// monomap eval render MAP_DIR DATASET [--stride N] [--width W] [--wrong-offset
+// M]
 //     [--first-frame F --frames N] [--align none|first-pose]
 // monomap eval trajectory ESTIMATE.txt GROUNDTRUTH.txt [--align ...]
 #include <cstdio>
@@ -469,6 +470,7 @@ void RegisterEvalCommand(CLI::App& app) {
   struct RenderArgs {
     std::string map_dir, dataset, align = "none", json;
     int stride = 5, first_frame = 0, num_frames = -1;
+    double wrong_offset_m = 0.05;
     RenderFidelityOptions options;
   };
   auto ra = std::make_shared<RenderArgs>();
@@ -500,6 +502,13 @@ void RegisterEvalCommand(CLI::App& app) {
                    "first-pose: align the map's first trajectory pose with "
                    "the dataset's ground truth at that time (same run)")
       ->check(CLI::IsMember({"none", "first-pose"}))
+      ->capture_default_str();
+  render
+      ->add_option("--wrong-offset", ra->wrong_offset_m,
+                   "Also compare renders from the true poses moved this far "
+                   "(m) along the camera's x axis: how much better the true "
+                   "pose matches (0: skip)")
+      ->check(CLI::Range(0.0, 1e3))
       ->capture_default_str();
   render->add_option("--json", ra->json, "Write the figures as JSON");
   render->callback([ra]() {
@@ -540,9 +549,42 @@ void RegisterEvalCommand(CLI::App& app) {
     j["alignment"] = ra->align;
     j["stride"] = ra->stride;
     j["width"] = ra->options.width;
-    PrintOrWrite(
-        j, "texture fidelity (alignment " + ra->align + ")\n" + FormatTable(f),
-        ra->json);
+    std::string text =
+        "texture fidelity (alignment " + ra->align + ")\n" + FormatTable(f);
+    if (ra->wrong_offset_m > 0) {
+      // The same frames from a wrong pose: a render that matched any pose
+      // equally well would say nothing about where the camera is.
+      std::vector<Rigid3d> wrong;
+      for (const Rigid3d& p : poses) {
+        wrong.push_back(p * Rigid3d(Eigen::Quaterniond::Identity(),
+                                    {ra->wrong_offset_m, 0.0, 0.0}));
+      }
+      const RenderFidelity w = EvaluateRenderFidelity(
+          map, dataset.camera, wrong, images, frames, ra->options);
+      int both = 0, true_better = 0;
+      for (const FrameFidelity& a : f.frames) {
+        for (const FrameFidelity& b : w.frames) {
+          if (b.frame != a.frame) continue;
+          ++both;
+          true_better += a.ncc > b.ncc ? 1 : 0;
+        }
+      }
+      const double share =
+          both > 0 ? static_cast<double>(true_better) / both : 0.0;
+      j["wrong_pose"] = {{"offset_m", ra->wrong_offset_m},
+                         {"ncc", ToJson(w.ncc)},
+                         {"compared", both},
+                         {"true_pose_better", share}};
+      char line[200];
+      std::snprintf(line, sizeof(line),
+                    "poses moved %.3f m along camera x: NCC median %.3f "
+                    "(true poses %.3f); the true pose matches better in "
+                    "%d of %d frames\n",
+                    ra->wrong_offset_m, w.ncc.median, f.ncc.median, true_better,
+                    both);
+      text += line;
+    }
+    PrintOrWrite(j, text, ra->json);
   });
 
   struct TrajArgs {
