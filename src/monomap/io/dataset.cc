@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 
+#include "monomap/io/image_file.h"
 #include "monomap/io/trajectory_io.h"
 #include "monomap/util/error.h"
 #include "monomap/util/file.h"
@@ -328,11 +329,8 @@ Dataset LoadDataset(const fs::path& root, const DatasetOptions& options) {
 
 cv::Mat Dataset::LoadImage(size_t i, bool color) const {
   const fs::path& path = frames.at(i).image_path;
-  cv::Mat image = cv::imread(path.string(), color ? cv::IMREAD_COLOR
-                                                  : cv::IMREAD_GRAYSCALE);
-  if (image.empty()) {
-    throw InputError(path.string() + ": cannot read image");
-  }
+  cv::Mat image =
+      ReadImageFile(path, color ? cv::IMREAD_COLOR : cv::IMREAD_GRAYSCALE);
   if (image.cols != camera.width || image.rows != camera.height) {
     throw InputError(path.string() + ": image is " +
                      std::to_string(image.cols) + "x" +

@@ -97,6 +97,22 @@ TEST(Dataset, WrongImageSizeIsNamed) {
   }
 }
 
+TEST(Dataset, TruncatedImageIsNamed) {
+  const fs::path dir = MakeDataset("truncated");
+  fs::resize_file(dir / "rgb" / "1.png",
+                  fs::file_size(dir / "rgb" / "1.png") / 2);
+  const Dataset ds = LoadDataset(dir);
+  EXPECT_EQ(ds.LoadImage(0).cols, 64);
+  try {
+    ds.LoadImage(1);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("1.png: truncated PNG"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(Dataset, MalformedCameraYamlNamesField) {
   const fs::path dir = MakeDataset("yaml");
   std::ofstream(dir / "camera.yaml") << "image_width: 64\nimage_height: 48\n"

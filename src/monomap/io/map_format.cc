@@ -2,13 +2,13 @@
 
 #include <cmath>
 #include <limits>
-#include <set>
-
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <set>
 
 #include "monomap/io/gltf.h"
+#include "monomap/io/image_file.h"
 #include "monomap/io/ply.h"
 #include "monomap/io/trajectory_io.h"
 #include "monomap/util/error.h"
@@ -250,12 +250,7 @@ TexturedPlane ReadPlane(const JsonFields& f, const json& p,
   if (!fs::is_regular_file(full)) {
     f.Fail(texture_field, "texture file " + full.string() + " is missing");
   }
-  const cv::Mat image = cv::imread(full.string(), cv::IMREAD_UNCHANGED);
-  if (image.empty()) {
-    throw InputError(full.string() +
-                     ": cannot decode texture image (or it has zero size)");
-  }
-  plane.texture = ToBgra(image);
+  plane.texture = ToBgra(ReadImageFile(full, cv::IMREAD_UNCHANGED));
   if (plane.texture.empty()) {
     throw InputError(full.string() +
                      ": texture must be an 8-bit grey, BGR or BGRA image");
