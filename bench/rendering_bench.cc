@@ -150,35 +150,41 @@ const Scene& GetScene(int which) {
   return which == 0 ? desk : hallway;
 }
 
+// The timed loop of every benchmark here: render all poses, one by one or
+// as a TBB batch; sets the renders_per_s and foreground counters.
+void RenderLoop(benchmark::State& state, const Renderer& renderer,
+                const Camera& camera, const std::vector<Rigid3d>& poses,
+                bool parallel) {
+  std::vector<cv::Mat> greys(poses.size());
+  cv::Mat grey;
+  double foreground = 0;
+  for (auto _ : state) {
+    foreground = 0;
+    if (parallel) {
+      for (const RenderStats& s : renderer.RenderBatch(camera, poses, &greys)) {
+        foreground += static_cast<double>(s.pixels_foreground) / s.pixels_total;
+      }
+    } else {
+      for (const Rigid3d& pose : poses) {
+        const RenderStats s = renderer.Render(camera, pose, &grey);
+        foreground += static_cast<double>(s.pixels_foreground) / s.pixels_total;
+      }
+    }
+    benchmark::ClobberMemory();
+  }
+  state.counters["renders_per_s"] =
+      benchmark::Counter(static_cast<double>(poses.size()) * state.iterations(),
+                         benchmark::Counter::kIsRate);
+  state.counters["foreground"] = foreground / poses.size();
+}
+
 // Args: scene (0 desk, 1 hallway), render width (4:3), parallel (0/1).
 void BM_Render(benchmark::State& state) {
   const Scene& scene = GetScene(static_cast<int>(state.range(0)));
   const int width = static_cast<int>(state.range(1));
   const bool parallel = state.range(2) != 0;
   const Camera camera = BaseCamera().Scaled(width, width * 3 / 4);
-  std::vector<cv::Mat> greys(kBatch);
-  cv::Mat grey;
-  double foreground = 0;
-  for (auto _ : state) {
-    foreground = 0;
-    if (parallel) {
-      const std::vector<RenderStats> stats =
-          scene.renderer.RenderBatch(camera, scene.poses, &greys);
-      for (const RenderStats& s : stats) {
-        foreground += static_cast<double>(s.pixels_foreground) / s.pixels_total;
-      }
-    } else {
-      for (const Rigid3d& pose : scene.poses) {
-        const RenderStats s = scene.renderer.Render(camera, pose, &grey);
-        foreground += static_cast<double>(s.pixels_foreground) / s.pixels_total;
-      }
-    }
-    benchmark::ClobberMemory();
-  }
-  state.counters["renders_per_s"] = benchmark::Counter(
-      static_cast<double>(kBatch) * state.iterations(),
-      benchmark::Counter::kIsRate);
-  state.counters["foreground"] = foreground / kBatch;
+  RenderLoop(state, scene.renderer, camera, scene.poses, parallel);
   state.SetLabel(std::string(state.range(0) == 0 ? "desk" : "hallway") +
                  (parallel ? " tbb" : " 1-thread"));
 }
@@ -244,28 +250,7 @@ void BM_RenderMap(benchmark::State& state, const std::string& dir) {
   // 4:3 whatever the map camera's aspect, as the localizer's renders.
   const int height = width * 3 / 4;
   const Camera camera = scene->camera.Scaled(width, height);
-  std::vector<cv::Mat> greys(kBatch);
-  cv::Mat grey;
-  double foreground = 0;
-  for (auto _ : state) {
-    foreground = 0;
-    if (parallel) {
-      for (const RenderStats& s :
-           scene->renderer->RenderBatch(camera, scene->poses, &greys)) {
-        foreground += static_cast<double>(s.pixels_foreground) / s.pixels_total;
-      }
-    } else {
-      for (const Rigid3d& pose : scene->poses) {
-        const RenderStats s = scene->renderer->Render(camera, pose, &grey);
-        foreground += static_cast<double>(s.pixels_foreground) / s.pixels_total;
-      }
-    }
-    benchmark::ClobberMemory();
-  }
-  state.counters["renders_per_s"] =
-      benchmark::Counter(static_cast<double>(kBatch) * state.iterations(),
-                         benchmark::Counter::kIsRate);
-  state.counters["foreground"] = foreground / kBatch;
+  RenderLoop(state, *scene->renderer, camera, scene->poses, parallel);
   state.SetLabel(dir + " " + std::to_string(width) + "x" +
                  std::to_string(height) + (parallel ? " tbb" : " 1-thread"));
 }
