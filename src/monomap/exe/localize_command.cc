@@ -142,6 +142,10 @@ void RegisterLocalizeCommand(CLI::App& app) {
                        {"merged", s.merged},
                        {"injected", s.injected},
                        {"relocalizing", s.relocalizing},
+                       {"particles_weighed", s.particles_weighed},
+                       {"refined", s.refined},
+                       {"weigh_seconds", s.weigh_seconds},
+                       {"mcc_seconds", s.mcc_seconds},
                        {"seconds", s.seconds}});
     }
     j["steps"] = steps;
