@@ -439,7 +439,29 @@ TEST_F(Cli, LocalizeTracksTheDatasetInItsMap) {
                  (data / "groundtruth.txt").string() + " --align none");
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("matched 40"), std::string::npos) << r.output;
-  EXPECT_TRUE(fs::exists(particles));
+  // The particle sets: one row per particle and step, the columns named in
+  // the header, unit quaternions, every step of the report present.
+  std::ifstream sets_in(particles);
+  std::string header;
+  std::getline(sets_in, header);
+  EXPECT_EQ(header, "step,x,y,z,qx,qy,qz,qw,log_weight");
+  size_t rows = 0;
+  int last_step = -1;
+  for (std::string row; std::getline(sets_in, row); ++rows) {
+    std::replace(row.begin(), row.end(), ',', ' ');
+    std::istringstream f(row);
+    int step;
+    double x, y, z, qx, qy, qz, qw, lw;
+    ASSERT_TRUE(f >> step >> x >> y >> z >> qx >> qy >> qz >> qw >> lw) << row;
+    EXPECT_NEAR(qx * qx + qy * qy + qz * qz + qw * qw, 1.0, 1e-5) << row;
+    last_step = std::max(last_step, step);
+  }
+  size_t particles_total = 0;
+  for (const auto& step : j["steps"]) {
+    particles_total += step["particles"].get<size_t>();
+  }
+  EXPECT_EQ(rows, particles_total);
+  EXPECT_EQ(last_step, 39);
 
   // Self-localization: the frames the map was built from, localized in it,
   // give back the map's own poses if its textures agree with them (a

@@ -65,8 +65,10 @@ void RegisterLocalizeCommand(CLI::App& app) {
   AddFrameRangeOptions(cmd, &a->first_frame, &a->num_frames);
   cmd->add_option("--seed", a->seed, "Seed of the filter");
   cmd->add_option("--report", a->report, "Per-step figures as JSON");
-  cmd->add_option("--particles-out", a->particles_out,
-                  "Write the particle sets per step (CSV: step x y z)");
+  cmd->add_option(
+      "--particles-out", a->particles_out,
+      "Write the particle sets per step (CSV: step, camera position, "
+      "orientation quaternion, log weight)");
   cmd->callback([a]() {
     const Map map = ReadMap(a->map_dir);
     DatasetOptions dataset_options;
@@ -108,13 +110,18 @@ void RegisterLocalizeCommand(CLI::App& app) {
     WriteTumTrajectory(a->output, trajectory,
                        "monomap localize --method " + a->method);
     if (!a->particles_out.empty()) {
-      std::string csv = "step,x,y,z,log_weight\n";
-      char line[160];
+      // Camera position and orientation (world_from_cam, TUM order) of
+      // every particle, for plotting the sets.
+      std::string csv = "step,x,y,z,qx,qy,qz,qw,log_weight\n";
+      char line[240];
       for (size_t s = 0; s < sets.size(); ++s) {
         for (const auto& p : sets[s]) {
           const auto& t = p.world_from_cam.translation;
-          std::snprintf(line, sizeof(line), "%zu,%.5f,%.5f,%.5f,%.4f\n", s,
-                        t.x(), t.y(), t.z(), p.log_weight);
+          const auto& q = p.world_from_cam.rotation;
+          std::snprintf(line, sizeof(line),
+                        "%zu,%.5f,%.5f,%.5f,%.7f,%.7f,%.7f,%.7f,%.4f\n", s,
+                        t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w(),
+                        p.log_weight);
           csv += line;
         }
       }
