@@ -76,6 +76,9 @@ struct SweepOptions {
   // Likelihood temperature of the measurement model (<= 0: the
   // localizer's default).
   double sigma = 0.0;
+  // MCC: width of the estimate's refinement (0: off; -1: the localizer's
+  // default).
+  int refine_width = -1;
   // MCC: least random particles injected per resampling (-1: the
   // localizer's default).
   int mcc_min_injected = -1;
@@ -297,6 +300,8 @@ nlohmann::json RunSeed(const SweepOptions& o, const std::string& world,
     lo.kld.min_particles = std::min(lo.kld.min_particles, lo.num_particles);
     lo.seed = static_cast<uint64_t>(seed);
     if (o.sigma > 0) lo.measurement.sigma = o.sigma;
+    if (o.refine_width == 0) lo.refine_estimate = false;
+    if (o.refine_width > 0) lo.refine_mcc.width = o.refine_width;
     if (o.mcc_min_injected >= 0) lo.mcc_min_injected = o.mcc_min_injected;
     if (o.mcc_max_rotation_deg > 0) {
       lo.mcc.max_rotation_deg = o.mcc_max_rotation_deg;
@@ -541,6 +546,7 @@ int Run(const SweepOptions& o) {
       {"ba_threads", o.ba_threads},
       {"mcc_min_injected", o.mcc_min_injected},
       {"sigma", o.sigma},
+      {"refine_width", o.refine_width},
       {"mcc_max_rotation_deg", o.mcc_max_rotation_deg},
       {"relocalize_drop", o.relocalize_drop},
       {"relocalize_fraction", o.relocalize_fraction},
@@ -613,6 +619,9 @@ int main(int argc, char** argv) {
                  "Bundle adjustment threads (1: bit-reproducible maps)");
   app.add_option("--sigma", o.sigma,
                  "Likelihood temperature of the measurement model (0: the "
+                 "localizer's default)");
+  app.add_option("--refine-width", o.refine_width,
+                 "MCC: width of the estimate's refinement (0: off; -1: the "
                  "localizer's default)");
   app.add_option("--mcc-min-injected", o.mcc_min_injected,
                  "MCC: least random particles injected per resampling "

@@ -510,6 +510,11 @@ TEST_F(Cli, LocalizeTracksTheDatasetInItsMap) {
   std::ifstream moved_in(moved);
   const nlohmann::json mj = nlohmann::json::parse(moved_in);
   EXPECT_GT(mj["final_translation_error_m"].get<double>(), 0.15);
+  // A refinement narrower than 16 px is refused.
+  r = RunMonomap("localize " + map.string() + " " + data.string() +
+                 " --refine-width 8 -o " + (*root_ / "x.txt").string());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--refine-width"), std::string::npos) << r.output;
   // --init-pose is for --init pose only; a malformed pose is named.
   r = RunMonomap("localize " + map.string() + " " + data.string() +
                  " --init global --init-pose \"" + pose + "\" -o " +

@@ -25,6 +25,7 @@ void RegisterLocalizeCommand(CLI::App& app) {
     int particles = 1000;
     std::string mcc_size, measure_size;
     int mcc_top_k = -1;
+    int refine_width = -1;
     double relocalize_drop = -1.0;
     int first_frame = 0, num_frames = -1;
     uint64_t seed = 1;
@@ -53,6 +54,10 @@ void RegisterLocalizeCommand(CLI::App& app) {
                   "WxH of the renders MCC tracks against (default 160x120)");
   cmd->add_option("--mcc-top-k", a->mcc_top_k,
                   "Heaviest particles MCC corrects per update (default 64)");
+  cmd->add_option("--refine-width", a->refine_width,
+                  "MCC: width of the render the estimate is refined against "
+                  "(default: the camera's, up to 1024; 0: no refinement)")
+      ->check(CLI::Range(0, 100000));
   cmd->add_option("--relocalize-drop", a->relocalize_drop,
                   "Inject particles over the area when the best "
                   "log-likelihood drops this far below its long-term "
@@ -100,6 +105,15 @@ void RegisterLocalizeCommand(CLI::App& app) {
                      &options.measurement.width, &options.measurement.height);
     }
     if (a->mcc_top_k >= 0) options.mcc_top_k = a->mcc_top_k;
+    if (a->refine_width == 0) {
+      options.refine_estimate = false;
+    } else if (a->refine_width > 0) {
+      if (a->refine_width < 16) {
+        throw OptionsError("--refine-width: must be 0 or at least 16");
+      }
+      // The height follows the camera's aspect (RefinementOptions).
+      options.refine_mcc.width = a->refine_width;
+    }
     if (a->relocalize_drop >= 0) options.relocalize_drop = a->relocalize_drop;
     options.seed = a->seed;
     std::vector<TimedPose> trajectory;
