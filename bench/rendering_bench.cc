@@ -1,7 +1,10 @@
 // Renders per second of rendering/Renderer on synthetic maps: a desk (one
 // 0.8 x 0.6 m plane, 1600x1200 texture) and a hallway (7 planes, 1024x1024
 // textures), at 80x60, 160x120 and 640x480, over a batch of 1000 poses,
-// single-threaded and with tbb::parallel_for (Renderer::RenderBatch).
+// in three modes: one thread (tbb::global_control), the batch in parallel
+// (Renderer::RenderBatch), and one by one with each render's rows in
+// parallel (renders of >= 200x150 px; the latency of one large render, as
+// in MCC's full-size refinement).
 //
 //   build/bench/rendering_bench --benchmark_counters_tabular=true
 //
@@ -11,12 +14,14 @@
 // renders are) and 1000 poses along its trajectory, each
 // moved by up to 2 cm and 2 degrees, as a particle set around the robot.
 #include <benchmark/benchmark.h>
+#include <tbb/global_control.h>
 
 #include <cmath>
 #include <cstdlib>
 #include <exception>
 #include <memory>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -150,17 +155,30 @@ const Scene& GetScene(int which) {
   return which == 0 ? desk : hallway;
 }
 
-// The timed loop of every benchmark here: render all poses, one by one or
-// as a TBB batch; sets the renders_per_s and foreground counters.
+// How the poses of a batch are rendered.
+enum Mode { kOneThread = 0, kPosesParallel = 1, kRowsParallel = 2 };
+
+const char* ModeLabel(int mode) {
+  return mode == kOneThread       ? " 1-thread"
+         : mode == kPosesParallel ? " tbb"
+                                  : " rows";
+}
+
+// The timed loop of every benchmark here: render all poses in `mode`; sets
+// the renders_per_s and foreground counters.
 void RenderLoop(benchmark::State& state, const Renderer& renderer,
                 const Camera& camera, const std::vector<Rigid3d>& poses,
-                bool parallel) {
+                int mode) {
   std::vector<cv::Mat> greys(poses.size());
   cv::Mat grey;
   double foreground = 0;
+  std::optional<tbb::global_control> one_thread;
+  if (mode == kOneThread) {
+    one_thread.emplace(tbb::global_control::max_allowed_parallelism, 1);
+  }
   for (auto _ : state) {
     foreground = 0;
-    if (parallel) {
+    if (mode == kPosesParallel) {
       for (const RenderStats& s : renderer.RenderBatch(camera, poses, &greys)) {
         foreground += static_cast<double>(s.pixels_foreground) / s.pixels_total;
       }
@@ -178,20 +196,22 @@ void RenderLoop(benchmark::State& state, const Renderer& renderer,
   state.counters["foreground"] = foreground / poses.size();
 }
 
-// Args: scene (0 desk, 1 hallway), render width (4:3), parallel (0/1).
+// Args: scene (0 desk, 1 hallway), render width (4:3), Mode.
 void BM_Render(benchmark::State& state) {
   const Scene& scene = GetScene(static_cast<int>(state.range(0)));
   const int width = static_cast<int>(state.range(1));
-  const bool parallel = state.range(2) != 0;
+  const int mode = static_cast<int>(state.range(2));
   const Camera camera = BaseCamera().Scaled(width, width * 3 / 4);
-  RenderLoop(state, scene.renderer, camera, scene.poses, parallel);
+  RenderLoop(state, scene.renderer, camera, scene.poses, mode);
   state.SetLabel(std::string(state.range(0) == 0 ? "desk" : "hallway") +
-                 (parallel ? " tbb" : " 1-thread"));
+                 ModeLabel(mode));
 }
 
 BENCHMARK(BM_Render)
-    ->ArgNames({"scene", "width", "parallel"})
-    ->ArgsProduct({{0, 1}, {80, 160, 640}, {0, 1}})
+    ->ArgNames({"scene", "width", "mode"})
+    ->ArgsProduct({{0, 1}, {80, 160, 640}, {kOneThread, kPosesParallel}})
+    ->Args({0, 640, kRowsParallel})
+    ->Args({1, 640, kRowsParallel})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
@@ -227,7 +247,7 @@ MapScene LoadMapScene(const std::string& dir) {
   return scene;
 }
 
-// Args: render width (4:3), parallel (0/1).
+// Args: render width (4:3), Mode.
 void BM_RenderMap(benchmark::State& state, const std::string& dir) {
   static std::vector<std::pair<std::string, MapScene>> cache;
   const MapScene* scene = nullptr;
@@ -246,13 +266,13 @@ void BM_RenderMap(benchmark::State& state, const std::string& dir) {
     scene = &cache.back().second;
   }
   const int width = static_cast<int>(state.range(0));
-  const bool parallel = state.range(1) != 0;
+  const int mode = static_cast<int>(state.range(1));
   // 4:3 whatever the map camera's aspect, as the localizer's renders.
   const int height = width * 3 / 4;
   const Camera camera = scene->camera.Scaled(width, height);
-  RenderLoop(state, *scene->renderer, camera, scene->poses, parallel);
+  RenderLoop(state, *scene->renderer, camera, scene->poses, mode);
   state.SetLabel(dir + " " + std::to_string(width) + "x" +
-                 std::to_string(height) + (parallel ? " tbb" : " 1-thread"));
+                 std::to_string(height) + ModeLabel(mode));
 }
 
 // Registered before main() runs the benchmarks; the maps load on first use.
@@ -265,8 +285,9 @@ const bool kMapsRegistered = [] {
     if (dir.empty()) continue;
     benchmark::RegisterBenchmark(("BM_RenderMap/" + dir).c_str(), BM_RenderMap,
                                  dir)
-        ->ArgNames({"width", "parallel"})
-        ->ArgsProduct({{80, 160, 640}, {0, 1}})
+        ->ArgNames({"width", "mode"})
+        ->ArgsProduct({{80, 160, 640}, {kOneThread, kPosesParallel}})
+        ->Args({640, kRowsParallel})
         ->Unit(benchmark::kMillisecond)
         ->UseRealTime();
   }

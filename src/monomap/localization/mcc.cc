@@ -1,13 +1,14 @@
 #include "monomap/localization/mcc.h"
 
-#include <cmath>
-#include <vector>
+#include <tbb/parallel_invoke.h>
 
+#include <cmath>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
 #include <opencv2/imgproc.hpp>
-#include <opencv2/video/tracking.hpp>
+#include <vector>
 
+#include "monomap/tracking/pyramidal_lk.h"
 #include "monomap/util/error.h"
 
 namespace monomap {
@@ -89,38 +90,48 @@ bool MonteCarloCorrector::Round(const cv::Mat& live_raw, const Rigid3d& start,
                   cv::MORPH_RECT,
                   cv::Size(2 * o.border_px + 1, 2 * o.border_px + 1)));
   }
+  // Corner detection on the render runs beside the preparation of the two
+  // images for KLT (the full-size refinement is one correction at a time,
+  // and these steps are most of its time).
   std::vector<cv::Point2f> corners;
-  cv::goodFeaturesToTrack(render, corners, o.max_corners, o.corner_quality,
-                          o.min_corner_distance_px, mask);
+  std::vector<cv::Mat> render_pyramid, live_pyramid;
+  PyrLkOptions lk;
+  lk.window = o.klt_window;
+  lk.levels = o.klt_levels;
+  tbb::parallel_invoke(
+      [&] {
+        cv::goodFeaturesToTrack(render, corners, o.max_corners,
+                                o.corner_quality, o.min_corner_distance_px,
+                                mask);
+      },
+      [&] {
+        // KLT assumes brightness constancy: bring the live image to the
+        // render's gain and offset (mean and spread over the map pixels),
+        // else exposure changes bias the tracks by tenths of a pixel.
+        cv::Scalar mr, sr, ml, sl;
+        cv::meanStdDev(render, mr, sr, mask);
+        cv::meanStdDev(live_raw, ml, sl, mask);
+        cv::Mat live;
+        if (sl[0] > 1.0 && sr[0] > 1.0) {
+          const double gain = sr[0] / sl[0];
+          live_raw.convertTo(live, CV_8U, gain, mr[0] - gain * ml[0]);
+        } else {
+          live = live_raw;
+        }
+        BuildLkPyramid(render, lk, &render_pyramid);
+        BuildLkPyramid(live, lk, &live_pyramid);
+      });
   stats->corners = static_cast<int>(corners.size());
   stats->tracked = stats->inliers = 0;
   if (static_cast<int>(corners.size()) < o.min_inliers) return false;
 
-  // KLT assumes brightness constancy: bring the live image to the render's
-  // gain and offset (mean and spread over the map pixels), else exposure
-  // changes bias the tracks by tenths of a pixel.
-  cv::Scalar mr, sr, ml, sl;
-  cv::meanStdDev(render, mr, sr, mask);
-  cv::meanStdDev(live_raw, ml, sl, mask);
-  cv::Mat live;
-  if (sl[0] > 1.0 && sr[0] > 1.0) {
-    const double gain = sr[0] / sl[0];
-    live_raw.convertTo(live, CV_8U, gain, mr[0] - gain * ml[0]);
-  } else {
-    live = live_raw;
-  }
-
-  const cv::Size win(o.klt_window, o.klt_window);
-  const cv::TermCriteria term(cv::TermCriteria::COUNT | cv::TermCriteria::EPS,
-                              30, 0.01);
   std::vector<cv::Point2f> fwd, back;
   std::vector<uchar> st_f, st_b;
   std::vector<float> err;
-  cv::calcOpticalFlowPyrLK(render, live, corners, fwd, st_f, err, win,
-                           o.klt_levels, term);
+  PyramidalLk(render_pyramid, live_pyramid, corners, &fwd, &st_f, &err, lk);
   back = corners;  // backward starts at the original corner positions
-  cv::calcOpticalFlowPyrLK(live, render, fwd, back, st_b, err, win,
-                           o.klt_levels, term, cv::OPTFLOW_USE_INITIAL_FLOW);
+  lk.use_initial_guess = true;
+  PyramidalLk(live_pyramid, render_pyramid, fwd, &back, &st_b, &err, lk);
 
   const Camera& c = render_camera_;
   std::vector<cv::Point3d> object;

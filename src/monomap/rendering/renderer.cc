@@ -1,14 +1,16 @@
 #include "monomap/rendering/renderer.h"
 
-#include <algorithm>
-#include <array>
-#include <cmath>
-#include <limits>
-#include <string>
+#include <tbb/parallel_for.h>
 
 #include <Eigen/Dense>
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <cmath>
+#include <cstdint>
+#include <limits>
 #include <opencv2/imgproc.hpp>
-#include <tbb/parallel_for.h>
+#include <string>
 
 #include "monomap/geometry/polygon.h"
 #include "monomap/util/error.h"
@@ -20,6 +22,10 @@ namespace {
 // a row, and one log2 per span keeps the per-pixel work to adds and a
 // division.
 constexpr int kSpan = 16;
+
+// Renders of at least this many pixels split their rows over threads
+// (a 752x480 render of the desk map took 4 ms alone).
+constexpr int64_t kParallelPixels = 200 * 150;
 
 // One mip level, C floats per texel (premultiplied channels then alpha),
 // padded by one texel of zeros on every side so that bilinear sampling at
@@ -286,9 +292,19 @@ RenderStats Renderer::RenderImpl(const Camera& camera,
   const float inv_near = static_cast<float>(1.0 / options_.z_near_m);
   const float alpha_min = static_cast<float>(options_.alpha_threshold);
 
+  // Pass 1: which planes face the camera, their pixel-to-texel homography
+  // and the image polygon of the region to scan.
+  struct PlaneView {
+    const PlaneData* plane;
+    Eigen::Matrix3d texel_from_pixel;
+    std::array<Eigen::Vector2d, 8> poly;
+    int n;           // vertices of poly
+    int row0, row1;  // rows it may cover
+  };
+  std::vector<PlaneView> views;
+  views.reserve(planes_.size());
   for (const auto& plane_ptr : planes_) {
     const PlaneData& plane = *plane_ptr;
-    const std::vector<Level>& levels = plane.levels<C>();
     const double ppm = plane.pixels_per_meter;
     const Eigen::Vector3d u_c = rot * plane.frame.u_axis;
     const Eigen::Vector3d v_c = rot * plane.frame.v_axis;
@@ -338,126 +354,163 @@ RenderStats Renderer::RenderImpl(const Camera& camera,
     const int row1 =
         std::min(height - 1, static_cast<int>(std::ceil(vmax + 1)));
 
-    const Eigen::Matrix3f h = texel_from_pixel.cast<float>();
-    const int num_levels = static_cast<int>(levels.size());
-    const double bias = options_.mip_bias;
-    const bool area_footprint = options_.mip_footprint == MipFootprint::kArea;
-    bool drawn = false;
+    views.push_back({&plane, texel_from_pixel, poly, n, row0, row1});
+  }
 
-    for (int v = row0; v <= row1; ++v) {
-      // Extent of the polygon within the band [v - 1, v + 1].
-      const double b0 = v - 1.0, b1 = v + 1.0;
-      double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-      for (int i = 0; i < n; ++i) {
-        const Eigen::Vector2d& p = poly[i];
-        const Eigen::Vector2d& q = poly[(i + 1) % n];
-        if (p.y() >= b0 && p.y() <= b1) {
-          lo = std::min(lo, p.x());
-          hi = std::max(hi, p.x());
-        }
-        for (double b : {b0, b1}) {
-          if ((p.y() - b) * (q.y() - b) < 0) {
-            const double x = p.x() + (b - p.y()) / (q.y() - p.y()) * (q.x() - p.x());
-            lo = std::min(lo, x);
-            hi = std::max(hi, x);
+  // Pass 2: rows [r_begin, r_end) of every plane in map order, so that a
+  // band of rows is independent of the others and the result does not
+  // depend on how the rows are split.
+  const double bias = options_.mip_bias;
+  const bool area_footprint = options_.mip_footprint == MipFootprint::kArea;
+  std::vector<std::atomic<bool>> drawn(views.size());
+  float* const zbuf = zbuffer.data();
+  std::atomic<int> pixels_foreground{0};
+  if (depth != nullptr) depth->create(height, width, CV_32FC1);
+  auto draw_rows = [&](int r_begin, int r_end) {
+    for (size_t pi = 0; pi < views.size(); ++pi) {
+      const PlaneView& view = views[pi];
+      const std::vector<Level>& levels = view.plane->template levels<C>();
+      const Eigen::Matrix3d& texel_from_pixel = view.texel_from_pixel;
+      const std::array<Eigen::Vector2d, 8>& poly = view.poly;
+      const int n = view.n;
+      const int row0 = std::max(view.row0, r_begin);
+      const int row1 = std::min(view.row1, r_end - 1);
+      const Eigen::Matrix3f h = texel_from_pixel.cast<float>();
+      const int num_levels = static_cast<int>(levels.size());
+      bool plane_drawn = false;
+
+      for (int v = row0; v <= row1; ++v) {
+        // Extent of the polygon within the band [v - 1, v + 1].
+        const double b0 = v - 1.0, b1 = v + 1.0;
+        double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+        for (int i = 0; i < n; ++i) {
+          const Eigen::Vector2d& p = poly[i];
+          const Eigen::Vector2d& q = poly[(i + 1) % n];
+          if (p.y() >= b0 && p.y() <= b1) {
+            lo = std::min(lo, p.x());
+            hi = std::max(hi, p.x());
           }
-        }
-      }
-      if (!(lo <= hi)) continue;
-      const int col0 = std::max(0, static_cast<int>(std::floor(lo - 1)));
-      const int col1 = std::min(width - 1, static_cast<int>(std::ceil(hi + 1)));
-      if (col0 > col1) continue;
-
-      const float fv = static_cast<float>(v);
-      const float x_row = h(0, 1) * fv + h(0, 2);
-      const float y_row = h(1, 1) * fv + h(1, 2);
-      const float w_row = h(2, 1) * fv + h(2, 2);
-      float* zrow = zbuffer.data() + static_cast<size_t>(v) * width;
-      uint8_t* out = image->ptr<uint8_t>(v);
-
-      for (int s0 = col0; s0 <= col1; s0 += kSpan) {
-        const int s1 = std::min(col1, s0 + kSpan - 1);
-        // Mip level from the texel footprint at the span's centre: rho^2 =
-        // |det d texel / d pixel| (area) or the squared longest of its
-        // columns; level = round(log2 rho).
-        int level = 0;
-        if (num_levels > 1) {
-          const double uc = 0.5 * (s0 + s1);
-          const Eigen::Vector3d t = texel_from_pixel * Eigen::Vector3d(uc, v, 1);
-          if (t.z() > 0) {
-            const double x = t.x() / t.z(), y = t.y() / t.z();
-            const Eigen::Matrix3d& hd = texel_from_pixel;
-            const double dxdu = (hd(0, 0) - x * hd(2, 0)) / t.z();
-            const double dydu = (hd(1, 0) - y * hd(2, 0)) / t.z();
-            const double dxdv = (hd(0, 1) - x * hd(2, 1)) / t.z();
-            const double dydv = (hd(1, 1) - y * hd(2, 1)) / t.z();
-            const double rho2 = area_footprint
-                                    ? std::abs(dxdu * dydv - dydu * dxdv)
-                                    : std::max(dxdu * dxdu + dydu * dydu,
-                                               dxdv * dxdv + dydv * dydv);
-            const double lambda = 0.5 * std::log2(rho2) + bias;
-            if (lambda > 0.5) {
-              level = std::min(num_levels - 1,
-                               static_cast<int>(std::floor(lambda + 0.5)));
+          for (double b : {b0, b1}) {
+            if ((p.y() - b) * (q.y() - b) < 0) {
+              const double x =
+                  p.x() + (b - p.y()) / (q.y() - p.y()) * (q.x() - p.x());
+              lo = std::min(lo, x);
+              hi = std::max(hi, x);
             }
           }
         }
-        const Level& lev = levels[level];
-        // Level-0 texel x -> padded level-L coordinate
-        // (x + 0.5) / 2^L - 0.5 + 1.
-        const float scale = std::ldexp(1.f, -level);
-        const float offset = 0.5f * scale + 0.5f;
-        const float x_max = static_cast<float>(lev.width + 1);
-        const float y_max = static_cast<float>(lev.height + 1);
-        const float* texels = lev.data.data();
-        const int stride = lev.stride;
+        if (!(lo <= hi)) continue;
+        const int col0 = std::max(0, static_cast<int>(std::floor(lo - 1)));
+        const int col1 =
+            std::min(width - 1, static_cast<int>(std::ceil(hi + 1)));
+        if (col0 > col1) continue;
 
-        for (int u = s0; u <= s1; ++u) {
-          const float fu = static_cast<float>(u);
-          const float w = w_row + h(2, 0) * fu;
-          // Nearest surface wins; 1/z <= 0 is behind the camera.
-          if (!(w > zrow[u]) || w > inv_near) continue;
-          const float inv_w = 1.f / w;
-          const float x = (x_row + h(0, 0) * fu) * inv_w * scale + offset;
-          const float y = (y_row + h(1, 0) * fu) * inv_w * scale + offset;
-          if (!(x >= 0.f && x < x_max && y >= 0.f && y < y_max)) continue;
-          const int xi = static_cast<int>(x);
-          const int yi = static_cast<int>(y);
-          const float fx = x - xi, fy = y - yi;
-          const float* p0 = texels + yi * stride + xi * C;
-          const float* p1 = p0 + stride;
-          float val[C];
-          for (int c = 0; c < C; ++c) {
-            const float top = p0[c] + fx * (p0[C + c] - p0[c]);
-            const float bottom = p1[c] + fx * (p1[C + c] - p1[c]);
-            val[c] = top + fy * (bottom - top);
+        const float fv = static_cast<float>(v);
+        const float x_row = h(0, 1) * fv + h(0, 2);
+        const float y_row = h(1, 1) * fv + h(1, 2);
+        const float w_row = h(2, 1) * fv + h(2, 2);
+        float* zrow = zbuf + static_cast<size_t>(v) * width;
+        uint8_t* out = image->ptr<uint8_t>(v);
+
+        for (int s0 = col0; s0 <= col1; s0 += kSpan) {
+          const int s1 = std::min(col1, s0 + kSpan - 1);
+          // Mip level from the texel footprint at the span's centre: rho^2 =
+          // |det d texel / d pixel| (area) or the squared longest of its
+          // columns; level = round(log2 rho).
+          int level = 0;
+          if (num_levels > 1) {
+            const double uc = 0.5 * (s0 + s1);
+            const Eigen::Vector3d t =
+                texel_from_pixel * Eigen::Vector3d(uc, v, 1);
+            if (t.z() > 0) {
+              const double x = t.x() / t.z(), y = t.y() / t.z();
+              const Eigen::Matrix3d& hd = texel_from_pixel;
+              const double dxdu = (hd(0, 0) - x * hd(2, 0)) / t.z();
+              const double dydu = (hd(1, 0) - y * hd(2, 0)) / t.z();
+              const double dxdv = (hd(0, 1) - x * hd(2, 1)) / t.z();
+              const double dydv = (hd(1, 1) - y * hd(2, 1)) / t.z();
+              const double rho2 = area_footprint
+                                      ? std::abs(dxdu * dydv - dydu * dxdv)
+                                      : std::max(dxdu * dxdu + dydu * dydu,
+                                                 dxdv * dxdv + dydv * dydv);
+              const double lambda = 0.5 * std::log2(rho2) + bias;
+              if (lambda > 0.5) {
+                level = std::min(num_levels - 1,
+                                 static_cast<int>(std::floor(lambda + 0.5)));
+              }
+            }
           }
-          const float alpha = val[C - 1];
-          if (alpha < alpha_min) continue;
-          const float inv_alpha = 1.f / alpha;
-          zrow[u] = w;
-          uint8_t* o = out + u * kOut;
-          for (int c = 0; c < kOut; ++c) {
-            o[c] = static_cast<uint8_t>(
-                std::min(255.f, val[c] * inv_alpha + 0.5f));
+          const Level& lev = levels[level];
+          // Level-0 texel x -> padded level-L coordinate
+          // (x + 0.5) / 2^L - 0.5 + 1.
+          const float scale = std::ldexp(1.f, -level);
+          const float offset = 0.5f * scale + 0.5f;
+          const float x_max = static_cast<float>(lev.width + 1);
+          const float y_max = static_cast<float>(lev.height + 1);
+          const float* texels = lev.data.data();
+          const int stride = lev.stride;
+
+          for (int u = s0; u <= s1; ++u) {
+            const float fu = static_cast<float>(u);
+            const float w = w_row + h(2, 0) * fu;
+            // Nearest surface wins; 1/z <= 0 is behind the camera.
+            if (!(w > zrow[u]) || w > inv_near) continue;
+            const float inv_w = 1.f / w;
+            const float x = (x_row + h(0, 0) * fu) * inv_w * scale + offset;
+            const float y = (y_row + h(1, 0) * fu) * inv_w * scale + offset;
+            if (!(x >= 0.f && x < x_max && y >= 0.f && y < y_max)) continue;
+            const int xi = static_cast<int>(x);
+            const int yi = static_cast<int>(y);
+            const float fx = x - xi, fy = y - yi;
+            const float* p0 = texels + yi * stride + xi * C;
+            const float* p1 = p0 + stride;
+            float val[C];
+            for (int c = 0; c < C; ++c) {
+              const float top = p0[c] + fx * (p0[C + c] - p0[c]);
+              const float bottom = p1[c] + fx * (p1[C + c] - p1[c]);
+              val[c] = top + fy * (bottom - top);
+            }
+            const float alpha = val[C - 1];
+            if (alpha < alpha_min) continue;
+            const float inv_alpha = 1.f / alpha;
+            zrow[u] = w;
+            uint8_t* o = out + u * kOut;
+            for (int c = 0; c < kOut; ++c) {
+              o[c] = static_cast<uint8_t>(
+                  std::min(255.f, val[c] * inv_alpha + 0.5f));
+            }
+            plane_drawn = true;
           }
-          drawn = true;
         }
       }
+      if (plane_drawn) drawn[pi].store(true, std::memory_order_relaxed);
     }
-    if (drawn) ++stats.planes_drawn;
+    // Depth from the band's inverse depths.
+    int foreground = 0;
+    for (int v = r_begin; v < r_end; ++v) {
+      const float* z = zbuf + static_cast<size_t>(v) * width;
+      float* d = depth != nullptr ? depth->ptr<float>(v) : nullptr;
+      for (int u = 0; u < width; ++u) {
+        const bool fg = z[u] > 0.f;
+        foreground += fg;
+        if (d != nullptr) d[u] = fg ? 1.f / z[u] : 0.f;
+      }
+    }
+    pixels_foreground.fetch_add(foreground, std::memory_order_relaxed);
+  };
+  // One render is serial below kParallelPixels (renders that small are
+  // parallel across poses instead: RenderBatch, the particle filter).
+  if (static_cast<int64_t>(width) * height >= kParallelPixels) {
+    tbb::parallel_for(tbb::blocked_range<int>(0, height, 16),
+                      [&](const tbb::blocked_range<int>& r) {
+                        draw_rows(r.begin(), r.end());
+                      });
+  } else {
+    draw_rows(0, height);
   }
+  for (const std::atomic<bool>& d : drawn) stats.planes_drawn += d.load();
+  stats.pixels_foreground = pixels_foreground.load();
 
-  if (depth != nullptr) depth->create(height, width, CV_32FC1);
-  for (int v = 0; v < height; ++v) {
-    const float* z = zbuffer.data() + static_cast<size_t>(v) * width;
-    float* d = depth != nullptr ? depth->ptr<float>(v) : nullptr;
-    for (int u = 0; u < width; ++u) {
-      const bool fg = z[u] > 0.f;
-      stats.pixels_foreground += fg;
-      if (d != nullptr) d[u] = fg ? 1.f / z[u] : 0.f;
-    }
-  }
   return stats;
 }
 

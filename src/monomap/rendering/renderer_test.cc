@@ -1,10 +1,11 @@
 #include "monomap/rendering/renderer.h"
 
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
 #include <cmath>
 #include <cstdio>
 #include <functional>
-
-#include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
 #include "monomap/util/error.h"
@@ -348,6 +349,44 @@ TEST(RendererTest, AreaFootprintMatchesBoxDownscaledObliqueView) {
   EXPECT_GT(ncc[0], 0.8);
   EXPECT_GT(ncc[0] - ncc[1], 0.1);
   EXPECT_GT(ncc[2] - ncc[1], 0.1);
+}
+
+// Large renders split their rows over threads; the split must not change a
+// pixel, also where one plane occludes another.
+TEST(RendererTest, ParallelRowsRenderLikeOneThread) {
+  const TexturedPlane back =
+      MakePlane(Vector3d(-1, -1, 0), Vector3d::UnitX(), Vector3d::UnitY(), 300,
+                600, 600, Smooth);
+  const TexturedPlane front =
+      MakePlane(Vector3d(-0.3, -0.3, 0.2), Vector3d::UnitX(),
+                Vector3d(0, 1, 0.5), 300, 180, 200, [](double s, double t) {
+                  return 60.0 + 120.0 * (std::fmod(s + t, 0.05) < 0.025);
+                });
+  const Renderer renderer({back, front});
+  const Camera cam = TestCamera();  // 640x480: above the parallel threshold
+  const Rigid3d pose =
+      LookAt(Vector3d(0.2, -0.1, 1.5), Vector3d(0, 0, 0), -Vector3d::UnitY());
+  cv::Mat serial, serial_depth, parallel, parallel_depth;
+  RenderStats serial_stats;
+  {
+    const tbb::global_control one(tbb::global_control::max_allowed_parallelism,
+                                  1);
+    serial_stats = renderer.Render(cam, pose, &serial, &serial_depth);
+  }
+  const RenderStats stats =
+      renderer.Render(cam, pose, &parallel, &parallel_depth);
+  EXPECT_EQ(stats.planes_drawn, 2);
+  EXPECT_EQ(stats.planes_drawn, serial_stats.planes_drawn);
+  EXPECT_EQ(stats.pixels_foreground, serial_stats.pixels_foreground);
+  EXPECT_GT(stats.pixels_foreground, cam.width * cam.height / 2);
+  EXPECT_EQ(cv::norm(serial, parallel, cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::norm(serial_depth, parallel_depth, cv::NORM_INF), 0.0);
+  // Both depths appear: the front plane occludes part of the back one.
+  double z_min = 0, z_max = 0;
+  cv::minMaxLoc(parallel_depth, &z_min, &z_max, nullptr, nullptr,
+                parallel_depth > 0.0f);
+  EXPECT_LT(z_min, 1.45);
+  EXPECT_GT(z_max, 1.45);
 }
 
 TEST(RendererTest, PlaneBehindOrOutsideRendersBackground) {

@@ -14,6 +14,7 @@
 #include <string>
 #include <utility>
 
+#include "monomap/tracking/pyramidal_lk.h"
 #include "monomap/util/error.h"
 #include "monomap/util/progress.h"
 
@@ -48,39 +49,15 @@ void KltTrackerOptions::Check() const {
 
 namespace {
 
-// cv::calcOpticalFlowPyrLK over chunks of the points in parallel (oneTBB):
-// the points are independent, so the result is the same as one call, but
-// the serial tracking stage no longer leaves the other cores idle.
-void ParallelPyrLk(const std::vector<cv::Mat>& from,
-                   const std::vector<cv::Mat>& to,
-                   const std::vector<cv::Point2f>& pts_in,
-                   std::vector<cv::Point2f>* pts_out,
-                   std::vector<uchar>* status, std::vector<float>* error,
-                   const KltTrackerOptions& options) {
-  const size_t n = pts_in.size();
-  pts_out->assign(n, cv::Point2f());
-  status->assign(n, 0);
-  error->assign(n, 0.0f);
-  const cv::Size window(options.window_size, options.window_size);
-  const cv::TermCriteria criteria(
-      cv::TermCriteria::COUNT | cv::TermCriteria::EPS,
-      options.lk_max_iterations, options.lk_epsilon);
-  // Chunks of >= 64 points amortise the per-call set-up of OpenCV.
-  tbb::parallel_for(
-      tbb::blocked_range<size_t>(0, n, 64),
-      [&](const tbb::blocked_range<size_t>& r) {
-        const std::vector<cv::Point2f> in(pts_in.begin() + r.begin(),
-                                          pts_in.begin() + r.end());
-        std::vector<cv::Point2f> out;
-        std::vector<uchar> st;
-        std::vector<float> err;
-        cv::calcOpticalFlowPyrLK(from, to, in, out, st, err, window,
-                                 options.pyramid_levels, criteria, 0,
-                                 options.lk_min_eigen_threshold);
-        std::copy(out.begin(), out.end(), pts_out->begin() + r.begin());
-        std::copy(st.begin(), st.end(), status->begin() + r.begin());
-        std::copy(err.begin(), err.end(), error->begin() + r.begin());
-      });
+// The Lucas-Kanade settings of the tracker's options.
+PyrLkOptions LkOptions(const KltTrackerOptions& options) {
+  PyrLkOptions lk;
+  lk.window = options.window_size;
+  lk.levels = options.pyramid_levels;
+  lk.max_iterations = options.lk_max_iterations;
+  lk.epsilon = options.lk_epsilon;
+  lk.min_eigen_threshold = options.lk_min_eigen_threshold;
+  return lk;
 }
 
 }  // namespace
@@ -103,9 +80,7 @@ void KltTracker::BuildPyramid(const cv::Mat& grey,
   // forward track and of this frame's backward track, so its gradients are
   // needed twice; computing them here once saves LK doing it twice.
   // Existing buffers of the right size are reused.
-  cv::buildOpticalFlowPyramid(
-      grey, *pyramid, cv::Size(options.window_size, options.window_size),
-      options.pyramid_levels, /*withDerivatives=*/true);
+  BuildLkPyramid(grey, LkOptions(options), pyramid);
 }
 
 void KltTracker::Track(int frame_index, const cv::Mat& grey) {
@@ -143,8 +118,8 @@ void KltTracker::Track(int frame_index, const cv::Mat& grey,
     std::vector<cv::Point2f> next_pts;
     std::vector<uchar> status;
     std::vector<float> error;
-    ParallelPyrLk(prev_pyramid_, pyramid, prev_pts, &next_pts, &status, &error,
-                  options_);
+    PyramidalLk(prev_pyramid_, pyramid, prev_pts, &next_pts, &status, &error,
+                LkOptions(options_));
 
     // Backward only for the features that survived the forward track.
     std::vector<size_t> forward_ok;
@@ -166,8 +141,8 @@ void KltTracker::Track(int frame_index, const cv::Mat& grey,
     if (!fwd_pts.empty()) {
       // No initial guess at the original position: starting there would
       // pull the backward track home even from content that changed.
-      ParallelPyrLk(pyramid, prev_pyramid_, fwd_pts, &back_pts, &back_status,
-                    &back_error, options_);
+      PyramidalLk(pyramid, prev_pyramid_, fwd_pts, &back_pts, &back_status,
+                  &back_error, LkOptions(options_));
     }
 
     const double margin = options_.border_margin_px;
