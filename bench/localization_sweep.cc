@@ -87,7 +87,7 @@ struct SweepOptions {
   double mcc_max_rotation_deg = 0.0;
   // Relocalization trigger (LocalizerOptions::relocalize_*; a negative
   // value: the localizer's default).
-  double relocalize_drop = -1.0;
+  double relocalize_ncc_drop = -1.0;
   double relocalize_fraction = -1.0;
   double relocalize_alpha_slow = -1.0;
   // Kidnapped robot: carried off after this many updates (0: no kidnapping,
@@ -306,7 +306,9 @@ nlohmann::json RunSeed(const SweepOptions& o, const std::string& world,
     if (o.mcc_max_rotation_deg > 0) {
       lo.mcc.max_rotation_deg = o.mcc_max_rotation_deg;
     }
-    if (o.relocalize_drop >= 0) lo.relocalize_drop = o.relocalize_drop;
+    if (o.relocalize_ncc_drop >= 0) {
+      lo.relocalize_ncc_drop = o.relocalize_ncc_drop;
+    }
     if (o.relocalize_fraction >= 0) {
       lo.relocalize_fraction = o.relocalize_fraction;
     }
@@ -548,7 +550,7 @@ int Run(const SweepOptions& o) {
       {"sigma", o.sigma},
       {"refine_width", o.refine_width},
       {"mcc_max_rotation_deg", o.mcc_max_rotation_deg},
-      {"relocalize_drop", o.relocalize_drop},
+      {"relocalize_ncc_drop", o.relocalize_ncc_drop},
       {"relocalize_fraction", o.relocalize_fraction},
       {"relocalize_alpha_slow", o.relocalize_alpha_slow},
       {"max_translation_error_m", o.accuracy.max_translation_error_m},
@@ -629,8 +631,8 @@ int main(int argc, char** argv) {
   app.add_option("--mcc-max-rotation-deg", o.mcc_max_rotation_deg,
                  "MCC: largest rotation of a correction (degrees; 0: the "
                  "localizer's default)");
-  app.add_option("--relocalize-drop", o.relocalize_drop,
-                 "Relocalization trigger: drop of the best log-likelihood "
+  app.add_option("--relocalize-ncc-drop", o.relocalize_ncc_drop,
+                 "Relocalization trigger: drop of the best particle's NCC "
                  "(0: off; negative: the localizer's default)");
   app.add_option("--relocalize-fraction", o.relocalize_fraction,
                  "Share of the budget injected while relocalizing "

@@ -26,7 +26,7 @@ void RegisterLocalizeCommand(CLI::App& app) {
     std::string mcc_size, measure_size;
     int mcc_top_k = -1;
     int refine_width = -1;
-    double relocalize_drop = -1.0;
+    double relocalize_ncc_drop = -1.0;
     int first_frame = 0, num_frames = -1;
     uint64_t seed = 1;
   };
@@ -58,10 +58,10 @@ void RegisterLocalizeCommand(CLI::App& app) {
                   "MCC: width of the render the estimate is refined against "
                   "(default: the camera's, up to 1024; 0: no refinement)")
       ->check(CLI::Range(0, 100000));
-  cmd->add_option("--relocalize-drop", a->relocalize_drop,
-                  "Inject particles over the area when the best "
-                  "log-likelihood drops this far below its long-term "
-                  "average (0: never; default: the localizer's)");
+  cmd->add_option("--relocalize-ncc-drop", a->relocalize_ncc_drop,
+                  "Inject particles over the area when the best particle's "
+                  "NCC drops this far below its long-term average (0: "
+                  "never; default: the localizer's, 0.035)");
   cmd->add_option("--measure-size", a->measure_size,
                   "WxH of the renders the weights compare (default 80x60)");
   cmd->add_option("--camera", a->camera_yaml,
@@ -114,7 +114,9 @@ void RegisterLocalizeCommand(CLI::App& app) {
       // The height follows the camera's aspect (RefinementOptions).
       options.refine_mcc.width = a->refine_width;
     }
-    if (a->relocalize_drop >= 0) options.relocalize_drop = a->relocalize_drop;
+    if (a->relocalize_ncc_drop >= 0) {
+      options.relocalize_ncc_drop = a->relocalize_ncc_drop;
+    }
     options.seed = a->seed;
     std::vector<TimedPose> trajectory;
     std::vector<std::vector<Particle>> sets;

@@ -55,7 +55,7 @@ void LocalizerOptions::Check() const {
   CheckOption(injection_fraction >= 0 && injection_fraction < 1,
               "injection_fraction", "must be in [0, 1)");
   CheckOption(mcc_min_injected >= 0, "mcc_min_injected", "must be >= 0");
-  CheckOption(relocalize_drop >= 0, "relocalize_drop", "must be >= 0");
+  CheckOption(relocalize_ncc_drop >= 0, "relocalize_ncc_drop", "must be >= 0");
   CheckOption(relocalize_fraction >= 0 && relocalize_fraction < 1,
               "relocalize_fraction", "must be in [0, 1)");
   CheckOption(relocalize_alpha_fast > 0 && relocalize_alpha_fast <= 1,
@@ -339,7 +339,7 @@ LocalizerEstimate Localizer::Step(const cv::Mat& live_image_raw,
 
   // Relocalization: fast and slow averages of the best log-likelihood.
   int n_relocalize = 0;
-  if (options_.relocalize_drop > 0) {
+  if (options_.relocalize_ncc_drop > 0) {
     double best_log = -std::numeric_limits<double>::infinity();
     for (const MeasurementScore& s : scores) {
       best_log = std::max(best_log, s.log_likelihood);
@@ -351,7 +351,9 @@ LocalizerEstimate Localizer::Step(const cv::Mat& live_image_raw,
       best_fast_ += options_.relocalize_alpha_fast * (best_log - best_fast_);
       best_slow_ += options_.relocalize_alpha_slow * (best_log - best_slow_);
     }
-    if (best_fast_ < best_slow_ - options_.relocalize_drop) {
+    const double drop =
+        options_.relocalize_ncc_drop / options_.measurement.sigma;
+    if (best_fast_ < best_slow_ - drop) {
       stats.relocalizing = true;
       n_relocalize = static_cast<int>(
           std::lround(options_.relocalize_fraction * options_.num_particles));

@@ -96,16 +96,18 @@ struct LocalizerOptions {
   // Relocalization. MCC merges the set down to a handful of particles, so
   // injection sized by the set (above) stays at a few particles even when
   // the filter is lost. Here a loss is detected from the best particle's
-  // log-likelihood: when its fast average falls more than relocalize_drop
-  // below its slow average, relocalize_fraction of the particle budget
+  // log-likelihood: when its fast average falls more than
+  // relocalize_ncc_drop / measurement.sigma (the same drop of NCC whatever
+  // the likelihood's temperature) below its slow average,
+  // relocalize_fraction of the particle budget
   // (num_particles) is injected over the area at each resampling, until
   // the drop is found (the fast average rises) or becomes the norm (the
   // slow one falls). The best particle, not the mean, so that the injected
-  // particles themselves do not lower the signal. 0: off. 0.7 (an NCC
-  // drop of 0.035 at sigma 0.05) lies between tracking's fluctuations and
-  // a kidnapping's drop in the sweeps (docs/benchmarks.md, "Kidnapped
-  // robot with relocalization").
-  double relocalize_drop = 0.7;
+  // particles themselves do not lower the signal. 0: off. 0.035 (0.7 log
+  // units at sigma 0.05) lies between tracking's fluctuations and a
+  // kidnapping's drop in the sweeps (docs/benchmarks.md, "Kidnapped robot
+  // with relocalization").
+  double relocalize_ncc_drop = 0.035;
   // Share of the budget injected per resampling while relocalizing.
   double relocalize_fraction = 0.1;
   // Smoothing of the fast and slow averages (weight of the newest update).
@@ -152,7 +154,7 @@ struct LocalizerStepStats {
   double cluster_weight = 0.0;  // weight share of the estimate's cluster
   int kld_bins = 0;
   int injected = 0;
-  bool relocalizing = false;  // relocalize_drop was exceeded this update
+  bool relocalizing = false;  // relocalize_ncc_drop was exceeded this update
   int mcc_attempted = 0;
   int mcc_accepted = 0;
   int merged = 0;

@@ -277,7 +277,7 @@ TEST_F(LocalizerTest, MccRecoversFromAKidnappingByInjection) {
     o.init_spread_deg = 1.0;
     o.injection_fraction = 0.0;
     o.mcc_min_injected = min_injected;
-    o.relocalize_drop = 0.0;  // injection alone (see the test below)
+    o.relocalize_ncc_drop = 0.0;  // injection alone (see the test below)
     o.seed = 2;
     Localizer loc(map(), camera(), o, mount());
     loc.InitializeAtPose(WorldFromCamOfBase(
@@ -322,7 +322,7 @@ TEST_F(LocalizerTest, RelocalizationRecoversFromAKidnappingWhileTracking) {
     o.init_spread_deg = 1.0;
     o.injection_fraction = 0.0;
     o.mcc_min_injected = 0;
-    o.relocalize_drop = drop;
+    o.relocalize_ncc_drop = drop;
     o.seed = 3;
     Localizer loc(map(), camera(), o, mount());
     loc.InitializeAtPose(WorldFromCamOfBase(drive.truth[0], mount()));
@@ -331,7 +331,7 @@ TEST_F(LocalizerTest, RelocalizationRecoversFromAKidnappingWhileTracking) {
   std::vector<LocalizerStepStats> off_stats, on_stats;
   const std::vector<double> stuck = run(0.0, &off_stats);
   const std::vector<double> recovered =
-      run(LocalizerOptions().relocalize_drop, &on_stats);
+      run(LocalizerOptions().relocalize_ncc_drop, &on_stats);
   std::string fired;
   for (const LocalizerStepStats& s : on_stats)
     fired += s.relocalizing ? '1' : '0';
@@ -394,7 +394,7 @@ TEST_F(LocalizerTest, LocalizeSequenceReadsADataset) {
   LocalizerOptions plain = o;
   plain.method = LocalizationMethod::kMcl;
   plain.injection_fraction = 0.0;
-  plain.relocalize_drop = 0.0;
+  plain.relocalize_ncc_drop = 0.0;
   LocalizeSequence(map_, first, plain, &trajectory, &sets);
   ASSERT_EQ(sets.size(), 1u);
   const Eigen::Vector3d odometry_start =
@@ -466,7 +466,7 @@ TEST(LocalizerOptions, CheckAndParse) {
   o.relocalize_alpha_slow = o.relocalize_alpha_fast;  // slow must be slower
   EXPECT_THROW(o.Check(), OptionsError);
   o = {};
-  o.relocalize_drop = -1.0;
+  o.relocalize_ncc_drop = -1.0;
   EXPECT_THROW(o.Check(), OptionsError);
   EXPECT_EQ(ParseLocalizationMethod("mcc"), LocalizationMethod::kMcc);
   EXPECT_EQ(ParseLocalizationState("6dof"), LocalizationState::k6Dof);
