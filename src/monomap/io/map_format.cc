@@ -90,6 +90,11 @@ class JsonFields {
     if (!value.is_number_integer()) {
       Fail(Join(parent, key), "expected an integer");
     }
+    if (value.is_number_unsigned() &&
+        value.get<uint64_t>() >
+            static_cast<uint64_t>(std::numeric_limits<int64_t>::max())) {
+      Fail(Join(parent, key), "out of range");
+    }
     return value.get<int64_t>();
   }
 
@@ -161,6 +166,10 @@ Camera ReadCamera(const JsonFields& f, const json& root) {
     f.Fail(camera.width <= 0 ? "camera.width" : "camera.height",
            "must be positive");
   }
+  // Checked before anything allocates an image of the camera's size.
+  const std::string size_error =
+      ImageSizeLimitError(camera.width, camera.height);
+  if (!size_error.empty()) f.Fail("camera", size_error);
   if (camera.fx <= 0) f.Fail("camera.fx", "must be positive");
   if (camera.fy <= 0) f.Fail("camera.fy", "must be positive");
   return camera;
@@ -171,6 +180,8 @@ TexturedPlane ReadPlane(const JsonFields& f, const json& p,
   if (!p.is_object()) f.Fail(field, "expected an object");
   TexturedPlane plane;
   plane.id = f.Int(p, field, "id");
+  // -1 means "no plane" in points.ply.
+  if (plane.id < 0) f.Fail(JsonFields::Join(field, "id"), "must be >= 0");
   plane.plane.normal = f.Vector<3>(p, field, "normal");
   const double normal_norm = plane.plane.normal.norm();
   if (std::abs(normal_norm - 1.0) > kMapUnitTolerance) {
@@ -347,7 +358,7 @@ Map ReadMap(const fs::path& dir) {
   json root;
   try {
     root = json::parse(ReadFileToString(json_path));
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {  // syntax, number overflow, ...
     throw InputError(json_path.string() + ": invalid JSON: " + e.what());
   }
   if (!root.is_object()) {
