@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <set>
 #include <string>
 
@@ -39,6 +40,12 @@ class OutputSafety : public ::testing::Test {
     fs::remove_all(*root_);
     delete root_;
   }
+  // A fresh folder per test, so that the tests also pass in one process.
+  void SetUp() override {
+    dir_ = *root_ / ::testing::UnitTest::GetInstance()->current_test_info()->name();
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
   static fs::path Data() { return *root_ / "data"; }
   static std::vector<std::string> BuildArgs(const fs::path& out, int frames) {
     return {"build", Data().string(), "-o", out.string(), "-q", "--no-ba",
@@ -57,26 +64,25 @@ class OutputSafety : public ::testing::Test {
       return -1;
     }
   }
-  // Entries of the fixture folder other than the dataset, the logs and
-  // `expected`.
-  static std::set<std::string> Extra(const std::set<std::string>& expected) {
+  // Entries of the test's folder other than the logs and `expected`.
+  std::set<std::string> Extra(const std::set<std::string>& expected) const {
     std::set<std::string> extra;
-    for (const auto& e : fs::directory_iterator(*root_)) {
+    for (const auto& e : fs::directory_iterator(dir_)) {
       const std::string name = e.path().filename().string();
-      if (name != "data" && e.path().extension() != ".log" &&
-          !expected.count(name)) {
+      if (e.path().extension() != ".log" && !expected.count(name)) {
         extra.insert(name);
       }
     }
     return extra;
   }
   static fs::path* root_;
+  fs::path dir_;
 };
 fs::path* OutputSafety::root_ = nullptr;
 
 TEST_F(OutputSafety, RefusesWhatIsNotItsOwnOutput) {
   // An existing file.
-  const fs::path file = *root_ / "notes.txt";
+  const fs::path file = dir_ / "notes.txt";
   std::ofstream(file) << "precious";
   RunResult r = Build(file, kOldFrames);
   EXPECT_EQ(r.exit_code, 2) << r.output;
@@ -85,7 +91,7 @@ TEST_F(OutputSafety, RefusesWhatIsNotItsOwnOutput) {
       << r.output;
   EXPECT_EQ(ReadFileToString(file), "precious");
   // A directory that is not a monomap map.
-  const fs::path foreign = *root_ / "photos";
+  const fs::path foreign = dir_ / "photos";
   fs::create_directories(foreign);
   std::ofstream(foreign / "a.jpg") << "precious";
   r = Build(foreign, kOldFrames);
@@ -102,24 +108,27 @@ TEST_F(OutputSafety, RefusesWhatIsNotItsOwnOutput) {
   EXPECT_TRUE(fs::exists(Data() / "rgb.txt"));
   EXPECT_FALSE(fs::exists(Data() / "map"));
   // A dataset is not replaced by a map, nor a map by a dataset.
-  r = RunMonomap("simulate lab-corner --frames 3 -q -o " + Data().string());
+  const std::string sim =
+      "simulate lab-corner --frames 2 --width 64 --height 48 -q -o ";
+  ASSERT_EQ(RunMonomap(sim + (dir_ / "sim").string()).exit_code, 0);
+  r = RunMonomap(sim + (dir_ / "sim").string());
   EXPECT_EQ(r.exit_code, 0) << r.output;  // its own kind: replaced
-  ASSERT_EQ(Build(*root_ / "map", kOldFrames).exit_code, 0);
-  r = RunMonomap("simulate lab-corner --frames 3 -q -o " +
-                 (*root_ / "map").string());
+  ASSERT_EQ(Build(dir_ / "map", kOldFrames).exit_code, 0);
+  r = RunMonomap(sim + (dir_ / "map").string());
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("is a monomap map directory, not a dataset"),
             std::string::npos)
       << r.output;
-  EXPECT_EQ(MapFrames(*root_ / "map"), kOldFrames);
+  EXPECT_EQ(MapFrames(dir_ / "map"), kOldFrames);
   // The demo refuses a foreign folder before doing anything.
   r = RunMonomap("demo -q -o " + foreign.string());
   EXPECT_EQ(r.exit_code, 2) << r.output;
-  EXPECT_EQ(Extra({"notes.txt", "photos", "map"}), std::set<std::string>());
+  EXPECT_EQ(Extra({"notes.txt", "photos", "map", "sim"}),
+            std::set<std::string>());
 }
 
 TEST_F(OutputSafety, ReplacesAPreviousMapAndLeavesNothingElse) {
-  const fs::path out = *root_ / "map";
+  const fs::path out = dir_ / "map";
   ASSERT_EQ(Build(out, kOldFrames).exit_code, 0);
   EXPECT_EQ(MapFrames(out), kOldFrames);
   const RunResult r = Build(out, kNewFrames);
@@ -133,16 +142,16 @@ TEST_F(OutputSafety, ReplacesAPreviousMapAndLeavesNothingElse) {
 // target holds a complete map there, and after a SIGKILL at that instant;
 // the next run cleans up what the killed one left.
 TEST_F(OutputSafety, AKillAtEachCommitStepKeepsACompleteMap) {
-  const fs::path out = *root_ / "map";
+  const fs::path out = dir_ / "map";
   ASSERT_EQ(Build(out, kOldFrames).exit_code, 0);
   for (const std::string stage : {"before-swap", "after-swap"}) {
     SCOPED_TRACE(stage);
     const int before = MapFrames(out);
     const pid_t pid = test::SpawnMonomap(BuildArgs(out, kNewFrames),
-                                         *root_ / (stage + ".log"),
+                                         dir_ / (stage + ".log"),
                                          {"MONOMAP_TEST_STOP_AT=" + stage});
     ASSERT_TRUE(test::WaitUntilStopped(pid))
-        << ReadFileToString(*root_ / (stage + ".log"));
+        << ReadFileToString(dir_ / (stage + ".log"));
     const int expected = stage == "before-swap" ? before : kNewFrames;
     EXPECT_EQ(MapFrames(out), expected);
     kill(pid, SIGKILL);
@@ -161,16 +170,16 @@ TEST_F(OutputSafety, AKillAtEachCommitStepKeepsACompleteMap) {
 // the target holds a complete map (old or new: the commit may win the race
 // with the signal) and no temporary is left.
 TEST_F(OutputSafety, SigtermCleansUpBeforeExiting) {
-  const fs::path out = *root_ / "map";
+  const fs::path out = dir_ / "map";
   ASSERT_EQ(Build(out, kOldFrames).exit_code, 0);
   const pid_t pid = test::SpawnMonomap(BuildArgs(out, kNewFrames),
-                                       *root_ / "term.log",
+                                       dir_ / "term.log",
                                        {"MONOMAP_TEST_STOP_AT=before-swap"});
   ASSERT_TRUE(test::WaitUntilStopped(pid));
   kill(pid, SIGTERM);
   kill(pid, SIGCONT);
   EXPECT_EQ(test::WaitForExit(pid), 128 + SIGTERM)
-      << ReadFileToString(*root_ / "term.log");
+      << ReadFileToString(dir_ / "term.log");
   const int frames = MapFrames(out);
   EXPECT_TRUE(frames == kOldFrames || frames == kNewFrames) << frames;
   EXPECT_EQ(Extra({"map"}), std::set<std::string>());
@@ -179,12 +188,12 @@ TEST_F(OutputSafety, SigtermCleansUpBeforeExiting) {
 // A second build to the same output waits for the first one's lock; when
 // the first dies, the second cleans up after it and commits.
 TEST_F(OutputSafety, ConcurrentWritersAreSerialized) {
-  const fs::path out = *root_ / "map";
+  const fs::path out = dir_ / "map";
   const pid_t first = test::SpawnMonomap(BuildArgs(out, kOldFrames),
-                                         *root_ / "first.log",
+                                         dir_ / "first.log",
                                          {"MONOMAP_TEST_STOP_AT=before-swap"});
   ASSERT_TRUE(test::WaitUntilStopped(first));
-  const fs::path second_log = *root_ / "second.log";
+  const fs::path second_log = dir_ / "second.log";
   const pid_t second =
       test::SpawnMonomap(BuildArgs(out, kNewFrames), second_log);
   bool waited = false;
@@ -199,6 +208,33 @@ TEST_F(OutputSafety, ConcurrentWritersAreSerialized) {
   EXPECT_EQ(test::WaitForExit(second), 0) << ReadFileToString(second_log);
   EXPECT_EQ(MapFrames(out), kNewFrames);
   EXPECT_EQ(Extra({"map"}), std::set<std::string>());
+}
+
+// --threads (oneTBB's global limit) changes the speed, not the map: every
+// file is byte-identical at 1 and 2 threads. A bad value is a usage error.
+TEST_F(OutputSafety, MapsAreByteIdenticalAtOneAndTwoThreads) {
+  std::map<std::string, std::string> files[2];
+  for (int threads : {1, 2}) {
+    const fs::path out = dir_ / ("threads" + std::to_string(threads));
+    const RunResult r =
+        RunMonomap("build " + Data().string() + " -q -o " + out.string() +
+                   " --threads " + std::to_string(threads));
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    for (const auto& e : fs::recursive_directory_iterator(out)) {
+      if (!e.is_regular_file()) continue;
+      files[threads - 1][fs::relative(e.path(), out).string()] =
+          ReadFileToString(e.path());
+    }
+  }
+  EXPECT_GE(files[0].size(), 5u);
+  ASSERT_EQ(files[0].size(), files[1].size());
+  for (const auto& [name, bytes] : files[0]) {
+    EXPECT_TRUE(files[1][name] == bytes) << name << " differs";
+  }
+  EXPECT_EQ(RunMonomap("build " + Data().string() + " -q -o " +
+                       (dir_ / "t0").string() + " --threads 0")
+                .exit_code,
+            2);
 }
 
 }  // namespace

@@ -100,9 +100,11 @@ std::vector<RgbEntry> ReadRgbList(const fs::path& root) {
                        "timestamp " + tokens[0] + " does not increase");
     }
     e.path = root / tokens[1];
-    if (!fs::is_regular_file(e.path)) {
+    std::error_code ec;
+    if (!fs::is_regular_file(e.path, ec)) {
       throw InputError(list.string(), line.number,
-                       "image '" + tokens[1] + "' not found");
+                       "image '" + tokens[1] +
+                           "' not found (or not a regular file)");
     }
     e.line = line.number;
     entries.push_back(e);
@@ -318,7 +320,8 @@ Rigid3d WorldFromCamOfBase(const Pose2d& base, const Rigid3d& base_from_cam) {
 
 Dataset LoadDataset(const fs::path& root, const DatasetOptions& options) {
   options.Check();
-  if (!fs::is_directory(root)) {
+  std::error_code ec;
+  if (!fs::is_directory(root, ec)) {
     throw InputError(root.string() + ": dataset directory not found");
   }
   Dataset ds;
@@ -331,7 +334,7 @@ Dataset LoadDataset(const fs::path& root, const DatasetOptions& options) {
   const fs::path odom2d_path = root / "odometry2d.txt";
   std::vector<TimedPose> odometry;
   std::vector<std::pair<double, Pose2d>> odometry2d;
-  if (fs::exists(odom2d_path)) {
+  if (PathExists(odom2d_path)) {
     ds.base_from_cam = ReadCameraMountYaml(root / "camera_mount.yaml");
     std::vector<int> lines;
     odometry2d = ReadOdometry2d(odom2d_path, &lines);
@@ -348,7 +351,7 @@ Dataset LoadDataset(const fs::path& root, const DatasetOptions& options) {
   }
   // odometry.txt, when present, gives the full 6-DoF camera odometry and
   // takes precedence for the 3D pose; odometry2d stays available.
-  if (fs::exists(odom_path)) {
+  if (PathExists(odom_path)) {
     std::vector<int> lines;
     odometry = ReadTumTrajectory(odom_path, &lines);
     CheckOdometryPlausible(
@@ -363,7 +366,7 @@ Dataset LoadDataset(const fs::path& root, const DatasetOptions& options) {
   }
   std::vector<TimedPose> groundtruth;
   const fs::path gt_path = root / "groundtruth.txt";
-  if (options.load_groundtruth && fs::exists(gt_path)) {
+  if (options.load_groundtruth && PathExists(gt_path)) {
     groundtruth = ReadTumTrajectory(gt_path);
     ds.has_groundtruth = true;
   }

@@ -175,7 +175,8 @@ cv::Mat ReadImageFile(const std::filesystem::path& path, int flags) {
     // libjpeg then only warns and fills the missing part with grey.
     const std::string problem = JpegDecodeProblem(data);
     if (!problem.empty()) {
-      throw InputError(path.string() + ": corrupt JPEG: " + problem);
+      throw InputError(path.string() + ": JPEG does not decode completely: " +
+                       problem);
     }
   }
   cv::Mat image;

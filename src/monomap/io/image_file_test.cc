@@ -91,7 +91,8 @@ TEST_F(ImageFileTest, TruncatedFilesAreNamed) {
   EXPECT_FALSE(cv::imread(patched.string(), cv::IMREAD_GRAYSCALE).empty());
   e = Error(patched);
   EXPECT_NE(e.find(patched.string()), std::string::npos) << e;
-  EXPECT_NE(e.find("corrupt JPEG: Premature end"), std::string::npos) << e;
+  EXPECT_NE(e.find("does not decode completely"), std::string::npos) << e;
+  EXPECT_NE(e.find("premature end"), std::string::npos) << e;
 
   EXPECT_NE(Error(Write(".png", 0)).find("empty"), std::string::npos);
   EXPECT_NE(Error(dir_ / "missing.png").find("not found"), std::string::npos);

@@ -258,7 +258,8 @@ TexturedPlane ReadPlane(const JsonFields& f, const json& p,
                               "' is not a plain file name in the map folder");
   }
   const fs::path full = dir / texture_path;
-  if (!fs::is_regular_file(full)) {
+  std::error_code ec;
+  if (!fs::is_regular_file(full, ec)) {
     f.Fail(texture_field, "texture file " + full.string() + " is missing");
   }
   plane.texture = ToBgra(ReadImageFile(full, cv::IMREAD_UNCHANGED));
@@ -312,7 +313,8 @@ std::string FormatMapJson(const Map& map) {
 }
 
 void WriteMap(const fs::path& dir, const Map& map) {
-  if (!fs::is_directory(dir)) {
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) {
     throw OutputError(dir.string() + ": map directory does not exist");
   }
   std::set<int> ids;
@@ -350,7 +352,9 @@ void WriteMap(const fs::path& dir, const Map& map) {
 
 Map ReadMap(const fs::path& dir) {
   const fs::path json_path = dir / kMapJsonFile;
-  if (!fs::is_regular_file(json_path)) {
+  // Anything else at the path (a FIFO, a symlink loop) is named by the
+  // reader below.
+  if (!PathExists(json_path)) {
     throw InputError(json_path.string() + ": missing (not a monomap map " +
                      "directory?)");
   }
@@ -393,7 +397,7 @@ Map ReadMap(const fs::path& dir) {
   if (num_frames < 0) f.Fail("num_frames", "negative");
 
   const fs::path trajectory_path = dir / kMapTrajectoryFile;
-  if (!fs::is_regular_file(trajectory_path)) {
+  if (!PathExists(trajectory_path)) {
     throw InputError(trajectory_path.string() + ": missing");
   }
   // An empty trajectory file (no poses) is valid only for num_frames = 0.
@@ -406,7 +410,7 @@ Map ReadMap(const fs::path& dir) {
   }
 
   const fs::path points_path = dir / kMapPointsFile;
-  if (fs::exists(points_path)) {
+  if (PathExists(points_path)) {
     map.landmarks = ReadLandmarksPly(points_path);
     if (static_cast<int64_t>(map.landmarks.size()) != num_landmarks) {
       throw InputError(points_path.string() + ": has " +

@@ -59,6 +59,11 @@ struct FdCloser {
 
 }  // namespace
 
+bool PathExists(const fs::path& path) {
+  struct stat st {};
+  return ::lstat(path.c_str(), &st) == 0;
+}
+
 void CheckRegularFile(const fs::path& path) {
   struct stat st {};
   if (::stat(path.c_str(), &st) != 0) ThrowOpenError(path, errno);
@@ -404,12 +409,14 @@ AtomicDirectory::AtomicDirectory(fs::path final_path, std::string kind)
     final_path_ = final_path_.parent_path();
   }
   std::error_code ec;
-  final_path_ = fs::absolute(final_path_, ec);
-  const fs::path parent = final_path_.parent_path();
+  fs::path parent = fs::absolute(final_path_, ec).parent_path();
   fs::create_directories(parent, ec);
   if (ec) {
     throw OutputError(parent.string() + ": cannot create: " + ec.message());
   }
+  // One spelling per folder: the lock registry is keyed by it.
+  parent = fs::weakly_canonical(parent, ec);
+  final_path_ = parent / final_path_.filename();
   lock_fd_ = LockParent(parent);
   try {
     const std::string name = final_path_.filename().string();

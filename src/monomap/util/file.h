@@ -33,6 +33,10 @@ std::vector<TextLine> ReadDataLines(const std::filesystem::path& path);
 std::string ReadFileToString(const std::filesystem::path& path,
                              int64_t max_bytes = kMaxInputFileBytes);
 
+// True if anything is at `path` (even a dangling or looping symbolic
+// link, which the reader then reports). Never throws.
+bool PathExists(const std::filesystem::path& path);
+
 // Throws InputError naming the path unless it is a regular file (after
 // following symbolic links). For readers that hand the path to a library.
 void CheckRegularFile(const std::filesystem::path& path);
