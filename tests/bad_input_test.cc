@@ -123,8 +123,7 @@ class BadInput : public ::testing::Test {
 
   // Runs `command` (with INPUT and OUT replaced) on a corrupted copy of
   // `good` for each case and checks the outcome.
-  static void RunCatalogue(const std::string& good,
-                           const std::string& command,
+  static void RunCatalogue(const std::string& good, const std::string& command,
                            const std::vector<Case>& cases,
                            const std::string& out_extension = "") {
     for (const Case& c : cases) {
@@ -143,8 +142,7 @@ class BadInput : public ::testing::Test {
                                  std::chrono::steady_clock::now() - start)
                                  .count();
       EXPECT_EQ(r.exit_code, 1) << r.output;  // bad input, never 4
-      EXPECT_EQ(r.output.find("internal error"), std::string::npos)
-          << r.output;
+      EXPECT_EQ(r.output.find("internal error"), std::string::npos) << r.output;
       EXPECT_NE(r.output.find(c.named), std::string::npos) << r.output;
       EXPECT_LT(seconds, 60.0);
       EXPECT_FALSE(fs::exists(out)) << "output written";
@@ -180,7 +178,9 @@ TEST_F(BadInput, Datasets) {
        },
        "jump of"},
       {"odometry2d_huge_yaw",
-       [](const fs::path& d) { Append(d / "odometry2d.txt", "99999 0 0 1e300\n"); },
+       [](const fs::path& d) {
+         Append(d / "odometry2d.txt", "99999 0 0 1e300\n");
+       },
        "odometry2d.txt:"},
       {"camera_yaml_wrong_node_kind",
        [](const fs::path& d) {
@@ -197,8 +197,8 @@ TEST_F(BadInput, Datasets) {
       {"camera_yaml_huge",
        [](const fs::path& d) {
          ReplaceLine(d / "camera.yaml", "image_width:", "image_width: 100000");
-         ReplaceLine(d / "camera.yaml", "image_height:",
-                     "image_height: 100000");
+         ReplaceLine(d / "camera.yaml",
+                     "image_height:", "image_height: 100000");
        },
        "camera.yaml"},
       {"rgb_list_fifo",
@@ -244,8 +244,7 @@ TEST_F(BadInput, Maps) {
     j.replace(j.find(from), from.size(), to);
     std::ofstream(d / "map.json", std::ios::trunc) << j;
   };
-  const std::string ply_head =
-      "ply\nformat ascii 1.0\n";
+  const std::string ply_head = "ply\nformat ascii 1.0\n";
   const std::vector<Case> cases = {
       {"ply_huge_count_no_properties",
        [&](const fs::path& d) {
@@ -265,9 +264,7 @@ TEST_F(BadInput, Maps) {
        },
        "points.ply"},
       {"texture_header_huge",
-       [](const fs::path& d) {
-         ClaimPngSize(d / "plane_0.png", 30000, 30000);
-       },
+       [](const fs::path& d) { ClaimPngSize(d / "plane_0.png", 30000, 30000); },
        "plane_0.png"},
       {"map_camera_huge",
        [&](const fs::path& d) {
@@ -279,9 +276,7 @@ TEST_F(BadInput, Maps) {
        [&](const fs::path& d) { set_json(d, "\"fx\": 50.0", "\"fx\": 1e400"); },
        "map.json"},
       {"map_plane_id_negative",
-       [&](const fs::path& d) {
-         set_json(d, "\"id\": 0", "\"id\": -1");
-       },
+       [&](const fs::path& d) { set_json(d, "\"id\": 0", "\"id\": -1"); },
        "planes[0].id"},
       {"map_json_symlink_loop",
        [](const fs::path& d) {

@@ -25,8 +25,8 @@ struct RunResult {
 // Runs `monomap ARGS` (a shell command line) to completion; a run that
 // hangs is killed after two minutes (exit code 137).
 inline RunResult RunMonomap(const std::string& args) {
-  const std::string cmd = "timeout -s KILL 120 " +
-                          std::string(MONOMAP_BINARY) + " " + args + " 2>&1";
+  const std::string cmd = "timeout -s KILL 120 " + std::string(MONOMAP_BINARY) +
+                          " " + args + " 2>&1";
   RunResult r;
   FILE* pipe = popen(cmd.c_str(), "r");
   if (!pipe) return r;
@@ -52,7 +52,8 @@ inline pid_t SpawnMonomap(const std::vector<std::string>& args,
   for (const std::string& e : env) putenv(const_cast<char*>(e.c_str()));
   std::vector<char*> argv;
   argv.push_back(const_cast<char*>(MONOMAP_BINARY));
-  for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+  for (const std::string& a : args)
+    argv.push_back(const_cast<char*>(a.c_str()));
   argv.push_back(nullptr);
   execv(MONOMAP_BINARY, argv.data());
   _exit(121);

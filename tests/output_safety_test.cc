@@ -42,14 +42,15 @@ class OutputSafety : public ::testing::Test {
   }
   // A fresh folder per test, so that the tests also pass in one process.
   void SetUp() override {
-    dir_ = *root_ / ::testing::UnitTest::GetInstance()->current_test_info()->name();
+    dir_ = *root_ /
+           ::testing::UnitTest::GetInstance()->current_test_info()->name();
     fs::remove_all(dir_);
     fs::create_directories(dir_);
   }
   static fs::path Data() { return *root_ / "data"; }
   static std::vector<std::string> BuildArgs(const fs::path& out, int frames) {
-    return {"build", Data().string(), "-o", out.string(), "-q", "--no-ba",
-            "--frames", std::to_string(frames)};
+    return {"build", Data().string(), "-o",       out.string(),
+            "-q",    "--no-ba",       "--frames", std::to_string(frames)};
   }
   static RunResult Build(const fs::path& out, int frames) {
     std::string line;
@@ -86,8 +87,7 @@ TEST_F(OutputSafety, RefusesWhatIsNotItsOwnOutput) {
   std::ofstream(file) << "precious";
   RunResult r = Build(file, kOldFrames);
   EXPECT_EQ(r.exit_code, 2) << r.output;
-  EXPECT_NE(r.output.find("notes.txt: exists and is a file"),
-            std::string::npos)
+  EXPECT_NE(r.output.find("notes.txt: exists and is a file"), std::string::npos)
       << r.output;
   EXPECT_EQ(ReadFileToString(file), "precious");
   // A directory that is not a monomap map.
@@ -147,9 +147,9 @@ TEST_F(OutputSafety, AKillAtEachCommitStepKeepsACompleteMap) {
   for (const std::string stage : {"before-swap", "after-swap"}) {
     SCOPED_TRACE(stage);
     const int before = MapFrames(out);
-    const pid_t pid = test::SpawnMonomap(BuildArgs(out, kNewFrames),
-                                         dir_ / (stage + ".log"),
-                                         {"MONOMAP_TEST_STOP_AT=" + stage});
+    const pid_t pid =
+        test::SpawnMonomap(BuildArgs(out, kNewFrames), dir_ / (stage + ".log"),
+                           {"MONOMAP_TEST_STOP_AT=" + stage});
     ASSERT_TRUE(test::WaitUntilStopped(pid))
         << ReadFileToString(dir_ / (stage + ".log"));
     const int expected = stage == "before-swap" ? before : kNewFrames;
@@ -172,9 +172,9 @@ TEST_F(OutputSafety, AKillAtEachCommitStepKeepsACompleteMap) {
 TEST_F(OutputSafety, SigtermCleansUpBeforeExiting) {
   const fs::path out = dir_ / "map";
   ASSERT_EQ(Build(out, kOldFrames).exit_code, 0);
-  const pid_t pid = test::SpawnMonomap(BuildArgs(out, kNewFrames),
-                                       dir_ / "term.log",
-                                       {"MONOMAP_TEST_STOP_AT=before-swap"});
+  const pid_t pid =
+      test::SpawnMonomap(BuildArgs(out, kNewFrames), dir_ / "term.log",
+                         {"MONOMAP_TEST_STOP_AT=before-swap"});
   ASSERT_TRUE(test::WaitUntilStopped(pid));
   kill(pid, SIGTERM);
   kill(pid, SIGCONT);
@@ -189,9 +189,9 @@ TEST_F(OutputSafety, SigtermCleansUpBeforeExiting) {
 // the first dies, the second cleans up after it and commits.
 TEST_F(OutputSafety, ConcurrentWritersAreSerialized) {
   const fs::path out = dir_ / "map";
-  const pid_t first = test::SpawnMonomap(BuildArgs(out, kOldFrames),
-                                         dir_ / "first.log",
-                                         {"MONOMAP_TEST_STOP_AT=before-swap"});
+  const pid_t first =
+      test::SpawnMonomap(BuildArgs(out, kOldFrames), dir_ / "first.log",
+                         {"MONOMAP_TEST_STOP_AT=before-swap"});
   ASSERT_TRUE(test::WaitUntilStopped(first));
   const fs::path second_log = dir_ / "second.log";
   const pid_t second =

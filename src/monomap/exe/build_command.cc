@@ -114,8 +114,7 @@ void RegisterBuildCommand(CLI::App& app) {
     CheckOutputDirectory(args->output, "map",
                          {args->dataset, args->camera_yaml});
     if (!args->report.empty()) {
-      CheckOutputFile(args->report, {args->dataset, args->output},
-                      "--report");
+      CheckOutputFile(args->report, {args->dataset, args->output}, "--report");
     }
     DatasetOptions dataset_options;
     dataset_options.first_frame = args->first_frame;

@@ -26,7 +26,8 @@ void InstallInterruptCleanup() {
     int sig = 0;
     if (sigwait(&set, &sig) != 0) return;
     RemoveRegisteredTemporaries();
-    std::fprintf(stderr, "monomap: interrupted by %s; temporary output removed\n",
+    std::fprintf(stderr,
+                 "monomap: interrupted by %s; temporary output removed\n",
                  strsignal(sig));
     std::_Exit(128 + sig);
   }).detach();

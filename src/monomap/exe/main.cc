@@ -2,11 +2,12 @@
 //
 // Exit status: 0 success, 1 bad input data, 2 bad command line, 3 a stage
 // failed or output could not be written, 4 unexpected internal error.
+#include <tbb/global_control.h>
+
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
 #include <memory>
-#include <tbb/global_control.h>
 
 #include "monomap/exe/commands.h"
 #include "monomap/exe/interrupt.h"

@@ -102,9 +102,9 @@ std::vector<RgbEntry> ReadRgbList(const fs::path& root) {
     e.path = root / tokens[1];
     std::error_code ec;
     if (!fs::is_regular_file(e.path, ec)) {
-      throw InputError(list.string(), line.number,
-                       "image '" + tokens[1] +
-                           "' not found (or not a regular file)");
+      throw InputError(
+          list.string(), line.number,
+          "image '" + tokens[1] + "' not found (or not a regular file)");
     }
     e.line = line.number;
     entries.push_back(e);
@@ -166,16 +166,13 @@ void CheckOdometryPlausible(const fs::path& path, const DatasetOptions& options,
                        "yaw beyond the plausible " +
                            std::to_string(kMaxOdometryYawRad) + " rad");
     }
-    const double step =
-        kept.empty() ? 0.0 : (p - position(kept.back())).norm();
-    if (options.max_odometry_step_m > 0 &&
-        step > options.max_odometry_step_m) {
-      const std::string what =
-          "jump of " + std::to_string(step) + " m from the previous sample "
-          "exceeds max_odometry_step_m " +
-          std::to_string(options.max_odometry_step_m);
-      if (options.odometry_jump_policy ==
-          DatasetOptions::JumpPolicy::kReject) {
+    const double step = kept.empty() ? 0.0 : (p - position(kept.back())).norm();
+    if (options.max_odometry_step_m > 0 && step > options.max_odometry_step_m) {
+      const std::string what = "jump of " + std::to_string(step) +
+                               " m from the previous sample "
+                               "exceeds max_odometry_step_m " +
+                               std::to_string(options.max_odometry_step_m);
+      if (options.odometry_jump_policy == DatasetOptions::JumpPolicy::kReject) {
         throw InputError(path.string(), lines[i],
                          what + " (--max-odometry-step-m)");
       }
@@ -282,20 +279,20 @@ void WriteCameraYaml(const fs::path& path, const Camera& c,
 
 Rigid3d ReadCameraMountYaml(const fs::path& path) {
   return WithYamlErrors(path, [&] {
-  const YAML::Node root = LoadYaml(path);
-  if (!root.IsMap()) throw InputError(path.string() + ": not a YAML mapping");
-  const YAML::Node m = root["base_from_cam"];
-  if (!m) throw InputError(path.string(), "base_from_cam", "missing");
-  const auto t = ReadNumbers(path, m["translation"],
-                             "base_from_cam.translation", 3);
-  const auto q = ReadNumbers(path, m["rotation_xyzw"],
-                             "base_from_cam.rotation_xyzw", 4);
-  const Eigen::Quaterniond quat(q[3], q[0], q[1], q[2]);
-  if (std::abs(quat.norm() - 1.0) > 1e-2) {
-    throw InputError(path.string(), "base_from_cam.rotation_xyzw",
-                     "quaternion is not unit length");
-  }
-  return Rigid3d(quat.normalized(), Eigen::Vector3d(t[0], t[1], t[2]));
+    const YAML::Node root = LoadYaml(path);
+    if (!root.IsMap()) throw InputError(path.string() + ": not a YAML mapping");
+    const YAML::Node m = root["base_from_cam"];
+    if (!m) throw InputError(path.string(), "base_from_cam", "missing");
+    const auto t =
+        ReadNumbers(path, m["translation"], "base_from_cam.translation", 3);
+    const auto q =
+        ReadNumbers(path, m["rotation_xyzw"], "base_from_cam.rotation_xyzw", 4);
+    const Eigen::Quaterniond quat(q[3], q[0], q[1], q[2]);
+    if (std::abs(quat.norm() - 1.0) > 1e-2) {
+      throw InputError(path.string(), "base_from_cam.rotation_xyzw",
+                       "quaternion is not unit length");
+    }
+    return Rigid3d(quat.normalized(), Eigen::Vector3d(t[0], t[1], t[2]));
   });
 }
 

@@ -6,12 +6,13 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
-#include <string>
 #include <opencv2/imgcodecs.hpp>
+#include <string>
 #include <vector>
 
 // After <cstdio>: jpeglib.h needs FILE and size_t.
 #include <jpeglib.h>
+
 #include <vector>
 
 #include "monomap/util/error.h"
@@ -175,8 +176,8 @@ cv::Mat ReadImageFile(const std::filesystem::path& path, int flags) {
     // libjpeg then only warns and fills the missing part with grey.
     const std::string problem = JpegDecodeProblem(data);
     if (!problem.empty()) {
-      throw InputError(path.string() + ": JPEG does not decode completely: " +
-                       problem);
+      throw InputError(path.string() +
+                       ": JPEG does not decode completely: " + problem);
     }
   }
   cv::Mat image;

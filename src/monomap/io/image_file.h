@@ -7,8 +7,8 @@
 
 #include <cstdint>
 #include <filesystem>
-#include <string>
 #include <opencv2/core.hpp>
+#include <string>
 
 namespace monomap {
 

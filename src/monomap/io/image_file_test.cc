@@ -121,7 +121,8 @@ TEST_F(ImageFileTest, HugeHeadersAreRefusedBeforeDecoding) {
   // JPEG: the height and width of the start-of-frame marker.
   std::vector<uint8_t> jpg;
   cv::imencode(".jpg", image_, jpg);
-  for (size_t i = 2; i + 8 < jpg.size(); i += 2 + (jpg[i + 2] << 8 | jpg[i + 3])) {
+  for (size_t i = 2; i + 8 < jpg.size();
+       i += 2 + (jpg[i + 2] << 8 | jpg[i + 3])) {
     if (jpg[i + 1] == 0xC0) {
       jpg[i + 5] = jpg[i + 7] = 0xEA;  // 60000
       jpg[i + 6] = jpg[i + 8] = 0x60;

@@ -135,10 +135,10 @@ void CheckElementCounts(const PlyHeader& header, size_t data_bytes,
     if (row_bytes > 0 && count > (data_bytes + slack) / row_bytes) {
       throw InputError(file + ": truncated PLY or bad count: element '" +
                        element.name + "' count " + std::to_string(count) +
-                       " needs at least " +
-                       std::to_string(row_bytes) + " bytes per row, the file "
-                       "has only " + std::to_string(data_bytes) +
-                       " bytes of data");
+                       " needs at least " + std::to_string(row_bytes) +
+                       " bytes per row, the file "
+                       "has only " +
+                       std::to_string(data_bytes) + " bytes of data");
     }
   }
 }
@@ -429,8 +429,8 @@ double CheckedId(double v, double lo, double hi,
                  const std::filesystem::path& path, const char* field,
                  size_t row) {
   if (!(v >= lo && v <= hi) || v != std::floor(v)) {
-    throw InputError(path.string() + ": vertex " + std::to_string(row) +
-                     ": '" + field + "' " + std::to_string(v) +
+    throw InputError(path.string() + ": vertex " + std::to_string(row) + ": '" +
+                     field + "' " + std::to_string(v) +
                      " is not an integer in [" + std::to_string(lo) + ", " +
                      std::to_string(hi) + "]");
   }
@@ -467,9 +467,9 @@ std::vector<Landmark> ReadLandmarksPly(const std::filesystem::path& path) {
                      CheckedId(columns[6][i], 0, 9.0e15, path, "feature_id", i))
                : static_cast<FeatureId>(i);
     l.plane_id = columns[7].size() == n
-                     ? static_cast<int>(CheckedId(columns[7][i], -1,
-                                                  std::numeric_limits<int>::max(),
-                                                  path, "plane", i))
+                     ? static_cast<int>(CheckedId(
+                           columns[7][i], -1, std::numeric_limits<int>::max(),
+                           path, "plane", i))
                      : -1;
   }
   return landmarks;

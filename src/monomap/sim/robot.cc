@@ -153,9 +153,11 @@ std::vector<TimedPose2d> SampleRobotPath(const RobotPath& path,
     if (max_samples > n && !path.closed()) {
       throw OptionsError(
           "num_frames: " + std::to_string(max_samples) + " frames need " +
-          std::to_string((max_samples - 1) * step) + " m of path, but the "
-          "open path has " + std::to_string(driven_length) + " m (at most " +
-          std::to_string(n) + " frames at this speed and rate); lower the "
+          std::to_string((max_samples - 1) * step) +
+          " m of path, but the "
+          "open path has " +
+          std::to_string(driven_length) + " m (at most " + std::to_string(n) +
+          " frames at this speed and rate); lower the "
           "speed or the number of frames");
     }
     return max_samples;
@@ -202,9 +204,8 @@ std::vector<TimedPose2d> SampleRobotPath(const RobotPath& path,
   const int n = sample_count(table_offset[m]);
   std::vector<TimedPose2d> out(n);
   for (int k = 0; k < n; ++k) {
-    const double target = path.closed()
-                              ? std::fmod(k * step, table_offset[m])
-                              : std::min(k * step, table_offset[m]);
+    const double target = path.closed() ? std::fmod(k * step, table_offset[m])
+                                        : std::min(k * step, table_offset[m]);
     const auto it =
         std::lower_bound(table_offset.begin(), table_offset.end(), target);
     const size_t i = std::clamp<size_t>(it - table_offset.begin(), 1,

@@ -93,7 +93,8 @@ std::string ReadFileToString(const fs::path& path, int64_t max_bytes) {
   std::string contents(static_cast<size_t>(st.st_size), '\0');
   size_t done = 0;
   while (done < contents.size()) {
-    const ssize_t n = ::read(fd, contents.data() + done, contents.size() - done);
+    const ssize_t n =
+        ::read(fd, contents.data() + done, contents.size() - done);
     if (n < 0 && errno == EINTR) continue;
     if (n < 0) {
       throw InputError(path.string() + ": read error: " + ErrnoText(errno));
@@ -209,8 +210,7 @@ int LockParent(const fs::path& parent) {
       if (errno != EINTR) {
         const int err = errno;
         ::close(fd);
-        throw OutputError(parent.string() + ": cannot lock: " +
-                          ErrnoText(err));
+        throw OutputError(parent.string() + ": cannot lock: " + ErrnoText(err));
       }
     }
   }
@@ -237,8 +237,8 @@ std::string OutputKind(const fs::path& dir) {
     const std::string prefix = "monomap-output ";
     if (text.rfind(prefix, 0) != 0) return "";
     text = text.substr(prefix.size());
-    while (!text.empty() && std::isspace(static_cast<unsigned char>(
-                                text.back()))) {
+    while (!text.empty() &&
+           std::isspace(static_cast<unsigned char>(text.back()))) {
       text.pop_back();
     }
     return text;
@@ -269,8 +269,8 @@ std::string OutputDirectoryRefusal(const fs::path& path,
   const std::string found = OutputKind(path);
   if (found == kind) return "";
   if (found.empty()) {
-    return "exists and is not a monomap " + kind +
-           " directory (no " + kOutputMarkerFile +
+    return "exists and is not a monomap " + kind + " directory (no " +
+           kOutputMarkerFile +
            " marker); refusing to replace it: remove it or choose another "
            "path";
   }
@@ -298,14 +298,16 @@ void CheckOutsideInputs(const fs::path& path,
   for (const fs::path& input : inputs) {
     if (input.empty()) continue;
     if (IsSameOrInside(path, input)) {
-      throw OptionsError(option + " " + path.string() + ": is or lies inside "
-                         "the input " + input.string() +
-                         "; refusing to write there");
+      throw OptionsError(option + " " + path.string() +
+                         ": is or lies inside "
+                         "the input " +
+                         input.string() + "; refusing to write there");
     }
     if (IsSameOrInside(input, path)) {
-      throw OptionsError(option + " " + path.string() + ": contains the "
-                         "input " + input.string() +
-                         "; refusing to replace it");
+      throw OptionsError(option + " " + path.string() +
+                         ": contains the "
+                         "input " +
+                         input.string() + "; refusing to replace it");
     }
   }
 }
@@ -434,8 +436,8 @@ AtomicDirectory::AtomicDirectory(fs::path final_path, std::string kind)
     }
     fs::create_directory(temp_path_, ec);
     if (ec) {
-      throw OutputError(temp_path_.string() + ": cannot create: " +
-                        ec.message());
+      throw OutputError(temp_path_.string() +
+                        ": cannot create: " + ec.message());
     }
   } catch (...) {
     if (!temp_path_.empty()) {
@@ -480,8 +482,10 @@ void AtomicDirectory::Commit() {
   }
   const int err = errno;
   if (!(err == EINVAL || err == ENOSYS || err == ENOTSUP)) {
-    throw OutputError(final_path_.string() + ": cannot move output into "
-                      "place: " + ErrnoText(err));
+    throw OutputError(final_path_.string() +
+                      ": cannot move output into "
+                      "place: " +
+                      ErrnoText(err));
   }
   // No RENAME_EXCHANGE on this file system: move the old output aside
   // first; the next run restores it if we die between the two renames.

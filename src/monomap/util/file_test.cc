@@ -1,7 +1,6 @@
 #include "monomap/util/file.h"
 
 #include <gtest/gtest.h>
-
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -77,8 +76,8 @@ TEST(File, AtomicDirectoryLeavesNothingWithoutCommit) {
   EXPECT_FALSE(fs::exists(out / "x.txt"));
   EXPECT_TRUE(fs::exists(out / "y.txt"));
   // Only the output itself is left beside it.
-  EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator()),
-            1);
+  EXPECT_EQ(
+      std::distance(fs::directory_iterator(dir), fs::directory_iterator()), 1);
 }
 
 std::string ErrorOf(const std::function<void()>& f) {
@@ -107,11 +106,13 @@ TEST(File, AtomicDirectoryRefusesWhatIsNotItsOwnKind) {
   }
   EXPECT_EQ(ReadFileToString(dir / "file"), "precious");
   EXPECT_EQ(ReadFileToString(dir / "foreign" / "a.txt"), "precious");
-  EXPECT_NE(ErrorOf([&] { CheckOutputDirectory(dir / "file", "map", {}); })
-                .find("is a file"),
+  EXPECT_NE(ErrorOf([&] {
+              CheckOutputDirectory(dir / "file", "map", {});
+            }).find("is a file"),
             std::string::npos);
-  EXPECT_NE(ErrorOf([&] { CheckOutputDirectory(dir / "other", "map", {}); })
-                .find("monomap dataset directory"),
+  EXPECT_NE(ErrorOf([&] {
+              CheckOutputDirectory(dir / "other", "map", {});
+            }).find("monomap dataset directory"),
             std::string::npos);
   // Absent, empty, or the same kind: accepted.
   EXPECT_NO_THROW(CheckOutputDirectory(dir / "absent", "map", {}));
@@ -134,15 +135,14 @@ TEST(File, OutputNeverOverlapsTheInput) {
   EXPECT_THROW(
       CheckOutputDirectory(dir / "input" / "map", "map", {dir / "input"}),
       OptionsError);
-  EXPECT_THROW(CheckOutputDirectory(dir / "input" / ".." / "input" / "x",
-                                    "map", {dir / "input"}),
+  EXPECT_THROW(CheckOutputDirectory(dir / "input" / ".." / "input" / "x", "map",
+                                    {dir / "input"}),
                OptionsError);
   EXPECT_THROW(CheckOutputDirectory(dir, "map", {dir / "input" / "sub"}),
                OptionsError);
   EXPECT_THROW(CheckOutputFile(dir / "input" / "camera.yaml", {dir / "input"}),
                OptionsError);
-  EXPECT_NO_THROW(
-      CheckOutputDirectory(dir / "input2", "map", {dir / "input"}));
+  EXPECT_NO_THROW(CheckOutputDirectory(dir / "input2", "map", {dir / "input"}));
   EXPECT_THROW(CheckOutputFile(dir / "input", {}), OptionsError);
 }
 
@@ -225,8 +225,9 @@ TEST(File, ReadersRefuseWhatIsNotARegularFile) {
   // A FIFO without a writer would block a plain open forever.
   EXPECT_NE(ErrorOf([&] { ReadFileToString(dir / "fifo"); }).find("a FIFO"),
             std::string::npos);
-  EXPECT_NE(ErrorOf([&] { ReadDataLines(dir / "loop_a"); })
-                .find("symbolic link loop"),
+  EXPECT_NE(ErrorOf([&] {
+              ReadDataLines(dir / "loop_a");
+            }).find("symbolic link loop"),
             std::string::npos);
   EXPECT_NE(ErrorOf([&] { ReadFileToString(dir / "d"); }).find("a directory"),
             std::string::npos);
@@ -235,16 +236,17 @@ TEST(File, ReadersRefuseWhatIsNotARegularFile) {
   EXPECT_THROW(CheckRegularFile(dir / "fifo"), InputError);
   EXPECT_THROW(CheckRegularFile(dir / "loop_b"), InputError);
   std::ofstream(dir / "big") << std::string(100, 'x');
-  EXPECT_NE(ErrorOf([&] { ReadFileToString(dir / "big", 99); })
-                .find("exceeds the limit"),
+  EXPECT_NE(ErrorOf([&] {
+              ReadFileToString(dir / "big", 99);
+            }).find("exceeds the limit"),
             std::string::npos);
   EXPECT_EQ(ReadFileToString(dir / "big", 100).size(), 100u);
 }
 
 TEST(File, OverlongLineIsNamed) {
   const fs::path dir = TempDir("longline");
-  std::ofstream(dir / "a.txt") << "1 2\n" << std::string(kMaxLineBytes + 1, '7')
-                               << "\n";
+  std::ofstream(dir / "a.txt") << "1 2\n"
+                               << std::string(kMaxLineBytes + 1, '7') << "\n";
   EXPECT_NE(ErrorOf([&] { ReadDataLines(dir / "a.txt"); }).find("a.txt:2:"),
             std::string::npos);
 }
