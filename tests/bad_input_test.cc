@@ -63,6 +63,19 @@ std::string DataLine(const fs::path& file, int n) {
   return "";
 }
 
+// Moves the 4th odometry sample 50 m along x: a jump in one step.
+void AddOdometryJump(const fs::path& dataset) {
+  const fs::path file = dataset / "odometry.txt";
+  const std::string line = DataLine(file, 3);
+  std::istringstream in(line);
+  double v[8];
+  for (double& x : v) in >> x;
+  ReplaceLine(file, line,
+              std::to_string(v[0]) + " " + std::to_string(v[1] + 50) + " " +
+                  std::to_string(v[2]) + " " + std::to_string(v[3]) +
+                  " 0 0 0 1");
+}
+
 // Writes a PNG header that claims `width` x `height` into `file`.
 void ClaimPngSize(const fs::path& file, uint32_t width, uint32_t height) {
   std::string png = ReadFileToString(file);
@@ -76,16 +89,8 @@ void ClaimPngSize(const fs::path& file, uint32_t width, uint32_t height) {
 class BadInput : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    root_ = new fs::path(fs::temp_directory_path() /
-                         ("monomap_bad_input_" + std::to_string(getpid())));
-    fs::remove_all(*root_);
-    fs::create_directories(*root_);
-    SimulationOptions sim;
-    sim.world = "lab-corner";
-    sim.num_frames = 12;
-    sim.width = 160;
-    sim.height = 120;
-    Simulate(sim, *root_ / "data");
+    root_ = new fs::path(
+        test::FolderWithDataset("monomap_bad_input", 12, 160, 120));
     WriteSmallMap(*root_ / "map");
   }
   static void TearDownTestSuite() {
@@ -166,17 +171,7 @@ TEST_F(BadInput, Datasets) {
          Append(d / "odometry.txt", "99999 1e300 0 0 0 0 0 1\n");
        },
        "odometry.txt:"},
-      {"odometry_jump",
-       [](const fs::path& d) {
-         std::istringstream l(DataLine(d / "odometry.txt", 3));
-         double v[8];
-         for (double& x : v) l >> x;
-         ReplaceLine(d / "odometry.txt", DataLine(d / "odometry.txt", 3),
-                     std::to_string(v[0]) + " " + std::to_string(v[1] + 50) +
-                         " " + std::to_string(v[2]) + " " +
-                         std::to_string(v[3]) + " 0 0 0 1");
-       },
-       "jump of"},
+      {"odometry_jump", AddOdometryJump, "jump of"},
       {"odometry2d_huge_yaw",
        [](const fs::path& d) {
          Append(d / "odometry2d.txt", "99999 0 0 1e300\n");
@@ -306,14 +301,7 @@ TEST_F(BadInput, OdometryJumpsCanBeDroppedAndReported) {
   const fs::path d = *root_ / "jump";
   fs::remove_all(d);
   fs::copy(*root_ / "data", d, fs::copy_options::recursive);
-  const std::string third = DataLine(d / "odometry.txt", 3);
-  std::istringstream l(third);
-  double v[8];
-  for (double& x : v) l >> x;
-  ReplaceLine(d / "odometry.txt", third,
-              std::to_string(v[0]) + " " + std::to_string(v[1] + 50) + " " +
-                  std::to_string(v[2]) + " " + std::to_string(v[3]) +
-                  " 0 0 0 1");
+  AddOdometryJump(d);
   const fs::path out = *root_ / "jump_map";
   const RunResult r = RunMonomap("build " + d.string() + " -q --no-ba -o " +
                                  out.string() + " --drop-odometry-jumps");

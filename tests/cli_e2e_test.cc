@@ -33,16 +33,8 @@ using test::RunResult;
 class Cli : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    root_ = new fs::path(fs::temp_directory_path() /
-                         ("monomap_cli_test_" + std::to_string(getpid())));
-    fs::remove_all(*root_);
-    fs::create_directories(*root_);
-    SimulationOptions sim;
-    sim.world = "lab-corner";
-    sim.num_frames = 40;
-    sim.width = 320;
-    sim.height = 240;
-    Simulate(sim, *root_ / "data");
+    root_ =
+        new fs::path(test::FolderWithDataset("monomap_cli_test", 40, 320, 240));
   }
   static void TearDownTestSuite() {
     fs::remove_all(*root_);

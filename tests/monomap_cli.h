@@ -15,6 +15,8 @@
 #include <thread>
 #include <vector>
 
+#include "monomap/sim/simulate.h"
+
 namespace monomap::test {
 
 struct RunResult {
@@ -80,6 +82,24 @@ inline int WaitForExit(pid_t pid) {
   if (waitpid(pid, &status, 0) != pid) return -1;
   if (WIFSIGNALED(status)) return 128 + WTERMSIG(status);
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+// A fresh, empty folder under the temp directory, unique to this process,
+// holding a simulated lab-corner dataset "data" of `frames` frames.
+inline std::filesystem::path FolderWithDataset(const std::string& prefix,
+                                               int frames, int width,
+                                               int height) {
+  const std::filesystem::path root = std::filesystem::temp_directory_path() /
+                                     (prefix + "_" + std::to_string(getpid()));
+  std::filesystem::remove_all(root);
+  std::filesystem::create_directories(root);
+  SimulationOptions sim;
+  sim.world = "lab-corner";
+  sim.num_frames = frames;
+  sim.width = width;
+  sim.height = height;
+  Simulate(sim, root / "data");
+  return root;
 }
 
 }  // namespace monomap::test

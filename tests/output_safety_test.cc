@@ -25,16 +25,8 @@ constexpr int kNewFrames = 30;  // the map replacing it
 class OutputSafety : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    root_ = new fs::path(fs::temp_directory_path() /
-                         ("monomap_output_test_" + std::to_string(getpid())));
-    fs::remove_all(*root_);
-    fs::create_directories(*root_);
-    SimulationOptions sim;
-    sim.world = "lab-corner";
-    sim.num_frames = kNewFrames;
-    sim.width = 320;
-    sim.height = 240;
-    Simulate(sim, *root_ / "data");
+    root_ = new fs::path(
+        test::FolderWithDataset("monomap_output_test", kNewFrames, 320, 240));
   }
   static void TearDownTestSuite() {
     fs::remove_all(*root_);
