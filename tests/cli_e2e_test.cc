@@ -21,44 +21,20 @@
 #include "monomap/io/map_format.h"
 #include "monomap/io/trajectory_io.h"
 #include "monomap/sim/simulate.h"
+#include "tests/monomap_cli.h"
 
 namespace monomap {
 namespace {
 namespace fs = std::filesystem;
 
-struct RunResult {
-  int exit_code = -1;
-  std::string output;  // stdout + stderr
-};
-
-RunResult RunMonomap(const std::string& args) {
-  const std::string cmd = std::string(MONOMAP_BINARY) + " " + args + " 2>&1";
-  RunResult r;
-  FILE* pipe = popen(cmd.c_str(), "r");
-  if (!pipe) return r;
-  std::array<char, 4096> buf;
-  size_t n;
-  while ((n = fread(buf.data(), 1, buf.size(), pipe)) > 0) {
-    r.output.append(buf.data(), n);
-  }
-  const int status = pclose(pipe);
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
+using test::RunMonomap;
+using test::RunResult;
 
 class Cli : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    root_ = new fs::path(fs::temp_directory_path() /
-                         ("monomap_cli_test_" + std::to_string(getpid())));
-    fs::remove_all(*root_);
-    fs::create_directories(*root_);
-    SimulationOptions sim;
-    sim.world = "lab-corner";
-    sim.num_frames = 40;
-    sim.width = 320;
-    sim.height = 240;
-    Simulate(sim, *root_ / "data");
+    root_ =
+        new fs::path(test::FolderWithDataset("monomap_cli_test", 40, 320, 240));
   }
   static void TearDownTestSuite() {
     fs::remove_all(*root_);

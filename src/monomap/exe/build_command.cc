@@ -29,6 +29,8 @@ void RegisterBuildCommand(CLI::App& app) {
     double max_image_radius = 0.0;
     bool quiet = false;
     bool ba_verbose = false;
+    double max_odometry_step_m = DatasetOptions().max_odometry_step_m;
+    bool drop_odometry_jumps = false;
     BundleAdjustmentOptions ba;
   };
   auto args = std::make_shared<Args>();
@@ -96,17 +98,39 @@ void RegisterBuildCommand(CLI::App& app) {
       ->check(CLI::PositiveNumber);
   cmd->add_flag("--refine-distortion", args->ba.refine_distortion,
                 "Bundle adjustment refines the lens distortion coefficients");
+  cmd->add_option("--max-odometry-step-m", args->max_odometry_step_m,
+                  "Largest odometry motion between two samples (m); a "
+                  "larger jump is refused as corrupt (0: no limit)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  cmd->add_flag("--drop-odometry-jumps", args->drop_odometry_jumps,
+                "Drop odometry samples beyond --max-odometry-step-m (and "
+                "list them) instead of refusing the dataset");
   cmd->add_flag("-q,--quiet", args->quiet, "No progress output");
   cmd->add_flag("--ba-verbose", args->ba_verbose,
                 "Print the bundle adjustment solver's progress and report");
   cmd->callback([args]() {
+    // Refused before minutes of work, and again under the lock at writing.
+    CheckOutputDirectory(args->output, "map",
+                         {args->dataset, args->camera_yaml});
+    if (!args->report.empty()) {
+      CheckOutputFile(args->report, {args->dataset, args->output}, "--report");
+    }
     DatasetOptions dataset_options;
     dataset_options.first_frame = args->first_frame;
     dataset_options.num_frames = args->num_frames;
     dataset_options.camera_yaml = args->camera_yaml;
+    dataset_options.max_odometry_step_m = args->max_odometry_step_m;
+    if (args->drop_odometry_jumps) {
+      dataset_options.odometry_jump_policy = DatasetOptions::JumpPolicy::kDrop;
+    }
     // Ground truth is never used to build maps.
     dataset_options.load_groundtruth = false;
     const Dataset dataset = LoadDataset(args->dataset, dataset_options);
+    for (const std::string& line : dataset.dropped_odometry_lines) {
+      std::fprintf(stderr, "monomap: %s: odometry jump dropped\n",
+                   line.c_str());
+    }
 
     MappingOptions options;
     options.bundle_adjustment = args->ba;

@@ -8,6 +8,7 @@
 #include "monomap/exe/commands.h"
 #include "monomap/io/dataset.h"
 #include "monomap/util/error.h"
+#include "monomap/util/file.h"
 
 namespace monomap {
 
@@ -46,6 +47,7 @@ void RegisterCalibrateCommand(CLI::App& app) {
       throw OptionsError("--board: expected COLSxROWS of inner corners, got '" +
                          a->board + "'");
     }
+    CheckOutputFile(a->output, {a->dataset});
     a->options.inner_corners_x = cols;
     a->options.inner_corners_y = rows;
     a->options.full_distortion = !a->radial_only;

@@ -6,6 +6,7 @@
 
 #include "monomap/exe/commands.h"
 #include "monomap/pipelines/demo_report.h"
+#include "monomap/util/file.h"
 
 namespace monomap {
 
@@ -43,6 +44,8 @@ void RegisterDemoCommand(CLI::App& app) {
   cmd->add_flag("--no-localization", args->no_localization,
                 "Map and evaluate only");
   cmd->callback([args, o]() {
+    CheckOutputDirectory(args->output, "demo", {});
+    MarkOutputDirectory(args->output, "demo");
     o->output_dir = args->output;
     o->show_progress = !args->quiet;
     o->localization.enabled = !args->no_localization;

@@ -431,7 +431,8 @@ void RegisterEvalCommand(CLI::App& app) {
     // points.ply does not hold: recompute it from the feature table.
     const std::filesystem::path features =
         std::filesystem::path(sa->map_dir) / "features.csv";
-    const bool have_features = std::filesystem::is_regular_file(features);
+    std::error_code ec;  // a loop or a FIFO: no features, not a throw
+    const bool have_features = std::filesystem::is_regular_file(features, ec);
     if (!have_features) {
       std::fprintf(stderr,
                    "monomap: note: %s missing: relative point errors use "

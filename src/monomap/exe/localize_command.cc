@@ -75,6 +75,7 @@ void RegisterLocalizeCommand(CLI::App& app) {
       "Write the particle sets per step (CSV: step, camera position, "
       "orientation quaternion, log weight)");
   cmd->callback([a]() {
+    CheckOutputFile(a->output, {a->map_dir, a->dataset});
     const Map map = ReadMap(a->map_dir);
     DatasetOptions dataset_options;
     dataset_options.first_frame = a->first_frame;

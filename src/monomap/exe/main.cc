@@ -2,15 +2,21 @@
 //
 // Exit status: 0 success, 1 bad input data, 2 bad command line, 3 a stage
 // failed or output could not be written, 4 unexpected internal error.
+#include <tbb/global_control.h>
+
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
+#include <memory>
 
 #include "monomap/exe/commands.h"
+#include "monomap/exe/interrupt.h"
 #include "monomap/util/error.h"
 #include "monomap/util/runtime.h"
 
 int main(int argc, char** argv) {
+  // Before any thread exists: see exe/interrupt.h.
+  monomap::InstallInterruptCleanup();
   // One OpenCV thread (oneTBB does the parallelism) and an allocator that
   // reuses freed image buffers: see util/runtime.h.
   monomap::ConfigureRuntime();
@@ -18,6 +24,20 @@ int main(int argc, char** argv) {
       "monomap: dense planar maps and localization from one camera and "
       "odometry"};
   app.require_subcommand(1);
+  // Global, so that every command takes it (also after the subcommand:
+  // fallthrough). Set while parsing, before the command's callback runs.
+  app.fallthrough();
+  std::unique_ptr<tbb::global_control> thread_limit;
+  app.add_option_function<int>(
+         "--threads",
+         [&thread_limit](int n) {
+           thread_limit = std::make_unique<tbb::global_control>(
+               tbb::global_control::max_allowed_parallelism,
+               static_cast<size_t>(n));
+         },
+         "Worker threads (oneTBB); results do not depend on it "
+         "(default: all cores)")
+      ->check(CLI::Range(1, 1024));
   monomap::RegisterBuildCommand(app);
   monomap::RegisterEvalCommand(app);
   monomap::RegisterSimulateCommand(app);

@@ -81,6 +81,8 @@ void RegisterRenderCommand(CLI::App& app) {
   cmd->add_flag("--color", a->color, "Render in colour");
   cmd->callback([a]() {
     CheckOutputNames(a->output, a->depth);
+    CheckOutputFile(a->output, {a->map_dir});
+    if (!a->depth.empty()) CheckOutputFile(a->depth, {a->map_dir}, "--depth");
     const Map map = ReadMap(a->map_dir);
     const Rigid3d world_from_cam = ParsePose(a->pose, "--pose");
     Camera camera = map.camera.Pinhole();

@@ -6,6 +6,7 @@
 #include "monomap/exe/commands.h"
 #include "monomap/sim/simulate.h"
 #include "monomap/sim/world.h"
+#include "monomap/util/file.h"
 
 namespace monomap {
 
@@ -58,6 +59,7 @@ void RegisterSimulateCommand(CLI::App& app) {
                 "Add specular highlights sweeping over the floor");
   cmd->add_flag("-q,--quiet", *quiet, "No progress output");
   cmd->callback([o, out, quiet]() {
+    CheckOutputDirectory(*out, "dataset", {});
     o->show_progress = !*quiet;
     const SimulationReport r = Simulate(*o, *out);
     if (!*quiet) {

@@ -21,6 +21,8 @@ void DatasetOptions::Check() const {
   CheckOption(first_frame >= 0, "dataset.first_frame", "must be >= 0");
   CheckOption(num_frames == -1 || num_frames > 0, "dataset.num_frames",
               "must be -1 (all) or > 0");
+  CheckOption(max_odometry_step_m >= 0, "dataset.max_odometry_step_m",
+              "must be >= 0 (0: no limit)");
 }
 
 namespace {
@@ -98,9 +100,11 @@ std::vector<RgbEntry> ReadRgbList(const fs::path& root) {
                        "timestamp " + tokens[0] + " does not increase");
     }
     e.path = root / tokens[1];
-    if (!fs::is_regular_file(e.path)) {
-      throw InputError(list.string(), line.number,
-                       "image '" + tokens[1] + "' not found");
+    std::error_code ec;
+    if (!fs::is_regular_file(e.path, ec)) {
+      throw InputError(
+          list.string(), line.number,
+          "image '" + tokens[1] + "' not found (or not a regular file)");
     }
     e.line = line.number;
     entries.push_back(e);
@@ -109,7 +113,8 @@ std::vector<RgbEntry> ReadRgbList(const fs::path& root) {
   return entries;
 }
 
-std::vector<std::pair<double, Pose2d>> ReadOdometry2d(const fs::path& path) {
+std::vector<std::pair<double, Pose2d>> ReadOdometry2d(
+    const fs::path& path, std::vector<int>* line_numbers) {
   std::vector<std::pair<double, Pose2d>> out;
   for (const TextLine& line : ReadDataLines(path)) {
     const auto tokens = SplitWhitespace(line.text);
@@ -130,14 +135,78 @@ std::vector<std::pair<double, Pose2d>> ReadOdometry2d(const fs::path& path) {
                        "timestamp " + tokens[0] + " does not increase");
     }
     out.push_back({v[0], Pose2d{v[1], v[2], v[3]}});
+    line_numbers->push_back(line.number);
   }
   if (out.empty()) throw InputError(path.string() + ": no poses");
   return out;
 }
 
+// Refuses odometry values beyond the plausibility bounds, and handles
+// jumps larger than options.max_odometry_step_m between consecutive
+// samples per options.odometry_jump_policy (dropped samples are removed
+// from `samples` and listed in `dropped`). `position` gives a sample's
+// position (m), `yaw` its unwrapped yaw (rad; 0 if it has none).
+template <typename Sample, typename Position, typename Yaw>
+void CheckOdometryPlausible(const fs::path& path, const DatasetOptions& options,
+                            Position position, Yaw yaw,
+                            std::vector<Sample>* samples,
+                            const std::vector<int>& lines,
+                            std::vector<std::string>* dropped) {
+  std::vector<Sample> kept;
+  for (size_t i = 0; i < samples->size(); ++i) {
+    const Eigen::Vector3d p = position((*samples)[i]);
+    if (!(p.norm() < kMaxOdometryTranslationM)) {
+      throw InputError(path.string(), lines[i],
+                       "position " + std::to_string(p.norm()) +
+                           " m from the origin is beyond the plausible " +
+                           std::to_string(kMaxOdometryTranslationM) + " m");
+    }
+    if (!(std::abs(yaw((*samples)[i])) < kMaxOdometryYawRad)) {
+      throw InputError(path.string(), lines[i],
+                       "yaw beyond the plausible " +
+                           std::to_string(kMaxOdometryYawRad) + " rad");
+    }
+    const double step = kept.empty() ? 0.0 : (p - position(kept.back())).norm();
+    if (options.max_odometry_step_m > 0 && step > options.max_odometry_step_m) {
+      const std::string what = "jump of " + std::to_string(step) +
+                               " m from the previous sample "
+                               "exceeds max_odometry_step_m " +
+                               std::to_string(options.max_odometry_step_m);
+      if (options.odometry_jump_policy == DatasetOptions::JumpPolicy::kReject) {
+        throw InputError(path.string(), lines[i],
+                         what + " (--max-odometry-step-m)");
+      }
+      dropped->push_back(path.string() + ":" + std::to_string(lines[i]));
+      continue;
+    }
+    kept.push_back((*samples)[i]);
+  }
+  if (kept.size() * 2 < samples->size()) {
+    throw InputError(path.string() + ": " +
+                     std::to_string(samples->size() - kept.size()) + " of " +
+                     std::to_string(samples->size()) +
+                     " samples are jumps; the odometry is not usable");
+  }
+  *samples = std::move(kept);
+}
+
 }  // namespace
 
-Camera ReadCameraYaml(const fs::path& path) {
+namespace {
+
+// Runs `read` and turns any yaml-cpp error it lets through (a node of the
+// wrong kind, e.g. BadSubscript) into an InputError naming the file.
+template <typename Read>
+auto WithYamlErrors(const fs::path& path, Read read) {
+  try {
+    return read();
+  } catch (const YAML::Exception& e) {
+    throw InputError(path.string(), e.mark.line + 1,
+                     "unexpected YAML structure: " + e.msg);
+  }
+}
+
+Camera ReadCameraYamlNodes(const fs::path& path) {
   const YAML::Node root = LoadYaml(path);
   if (!root.IsMap()) throw InputError(path.string() + ": not a YAML mapping");
   Camera c;
@@ -146,6 +215,10 @@ Camera ReadCameraYaml(const fs::path& path) {
   if (c.width <= 0 || c.height <= 0) {
     throw InputError(path.string(), "image_width/image_height",
                      "must be positive");
+  }
+  const std::string size_error = ImageSizeLimitError(c.width, c.height);
+  if (!size_error.empty()) {
+    throw InputError(path.string(), "image_width/image_height", size_error);
   }
   const YAML::Node k = root["camera_matrix"];
   if (!k) throw InputError(path.string(), "camera_matrix", "missing");
@@ -183,6 +256,12 @@ Camera ReadCameraYaml(const fs::path& path) {
   return c;
 }
 
+}  // namespace
+
+Camera ReadCameraYaml(const fs::path& path) {
+  return WithYamlErrors(path, [&] { return ReadCameraYamlNodes(path); });
+}
+
 void WriteCameraYaml(const fs::path& path, const Camera& c,
                      const std::string& name) {
   std::ostringstream out;
@@ -199,19 +278,22 @@ void WriteCameraYaml(const fs::path& path, const Camera& c,
 }
 
 Rigid3d ReadCameraMountYaml(const fs::path& path) {
-  const YAML::Node root = LoadYaml(path);
-  const YAML::Node m = root["base_from_cam"];
-  if (!m) throw InputError(path.string(), "base_from_cam", "missing");
-  const auto t = ReadNumbers(path, m["translation"],
-                             "base_from_cam.translation", 3);
-  const auto q = ReadNumbers(path, m["rotation_xyzw"],
-                             "base_from_cam.rotation_xyzw", 4);
-  const Eigen::Quaterniond quat(q[3], q[0], q[1], q[2]);
-  if (std::abs(quat.norm() - 1.0) > 1e-2) {
-    throw InputError(path.string(), "base_from_cam.rotation_xyzw",
-                     "quaternion is not unit length");
-  }
-  return Rigid3d(quat.normalized(), Eigen::Vector3d(t[0], t[1], t[2]));
+  return WithYamlErrors(path, [&] {
+    const YAML::Node root = LoadYaml(path);
+    if (!root.IsMap()) throw InputError(path.string() + ": not a YAML mapping");
+    const YAML::Node m = root["base_from_cam"];
+    if (!m) throw InputError(path.string(), "base_from_cam", "missing");
+    const auto t =
+        ReadNumbers(path, m["translation"], "base_from_cam.translation", 3);
+    const auto q =
+        ReadNumbers(path, m["rotation_xyzw"], "base_from_cam.rotation_xyzw", 4);
+    const Eigen::Quaterniond quat(q[3], q[0], q[1], q[2]);
+    if (std::abs(quat.norm() - 1.0) > 1e-2) {
+      throw InputError(path.string(), "base_from_cam.rotation_xyzw",
+                       "quaternion is not unit length");
+    }
+    return Rigid3d(quat.normalized(), Eigen::Vector3d(t[0], t[1], t[2]));
+  });
 }
 
 void WriteCameraMountYaml(const fs::path& path, const Rigid3d& base_from_cam) {
@@ -235,7 +317,8 @@ Rigid3d WorldFromCamOfBase(const Pose2d& base, const Rigid3d& base_from_cam) {
 
 Dataset LoadDataset(const fs::path& root, const DatasetOptions& options) {
   options.Check();
-  if (!fs::is_directory(root)) {
+  std::error_code ec;
+  if (!fs::is_directory(root, ec)) {
     throw InputError(root.string() + ": dataset directory not found");
   }
   Dataset ds;
@@ -248,17 +331,31 @@ Dataset LoadDataset(const fs::path& root, const DatasetOptions& options) {
   const fs::path odom2d_path = root / "odometry2d.txt";
   std::vector<TimedPose> odometry;
   std::vector<std::pair<double, Pose2d>> odometry2d;
-  if (fs::exists(odom2d_path)) {
+  if (PathExists(odom2d_path)) {
     ds.base_from_cam = ReadCameraMountYaml(root / "camera_mount.yaml");
-    odometry2d = ReadOdometry2d(odom2d_path);
+    std::vector<int> lines;
+    odometry2d = ReadOdometry2d(odom2d_path, &lines);
+    CheckOdometryPlausible(
+        odom2d_path, options,
+        [](const auto& s) {
+          return Eigen::Vector3d(s.second.x, s.second.y, 0.0);
+        },
+        [](const auto& s) { return s.second.yaw; }, &odometry2d, lines,
+        &ds.dropped_odometry_lines);
     for (const auto& [t, p] : odometry2d) {
       odometry.push_back({t, WorldFromCamOfBase(p, *ds.base_from_cam)});
     }
   }
   // odometry.txt, when present, gives the full 6-DoF camera odometry and
   // takes precedence for the 3D pose; odometry2d stays available.
-  if (fs::exists(odom_path)) {
-    odometry = ReadTumTrajectory(odom_path);
+  if (PathExists(odom_path)) {
+    std::vector<int> lines;
+    odometry = ReadTumTrajectory(odom_path, &lines);
+    CheckOdometryPlausible(
+        odom_path, options,
+        [](const TimedPose& p) { return p.world_from_cam.translation; },
+        [](const TimedPose&) { return 0.0; }, &odometry, lines,
+        &ds.dropped_odometry_lines);
   } else if (odometry.empty()) {
     throw InputError(root.string() +
                      ": no odometry (need odometry.txt, or odometry2d.txt "
@@ -266,7 +363,7 @@ Dataset LoadDataset(const fs::path& root, const DatasetOptions& options) {
   }
   std::vector<TimedPose> groundtruth;
   const fs::path gt_path = root / "groundtruth.txt";
-  if (options.load_groundtruth && fs::exists(gt_path)) {
+  if (options.load_groundtruth && PathExists(gt_path)) {
     groundtruth = ReadTumTrajectory(gt_path);
     ds.has_groundtruth = true;
   }

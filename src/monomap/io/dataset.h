@@ -33,9 +33,22 @@ struct DatasetOptions {
   // Calibration to use instead of DATASET/camera.yaml (empty: that one),
   // e.g. one written by `monomap calibrate`.
   std::filesystem::path camera_yaml;
+  // Largest odometry motion (m) between two consecutive samples; a larger
+  // jump is a corrupt sample (0: no limit). See odometry_jump_policy.
+  double max_odometry_step_m = 2.0;
+  // What to do with a sample beyond max_odometry_step_m: refuse the
+  // dataset naming its line, or drop it and list it in
+  // Dataset::dropped_odometry_lines.
+  enum class JumpPolicy { kReject, kDrop };
+  JumpPolicy odometry_jump_policy = JumpPolicy::kReject;
 
   void Check() const;
 };
+
+// Plausibility bounds on odometry values (docs/reliability.md): anything
+// beyond is refused as corrupt.
+inline constexpr double kMaxOdometryTranslationM = 1e4;
+inline constexpr double kMaxOdometryYawRad = 1e4;  // unwrapped yaw
 
 // Planar robot base pose on the floor.
 struct Pose2d {
@@ -57,6 +70,8 @@ struct Dataset {
   // Set when the odometry came from odometry2d.txt + camera_mount.yaml.
   std::optional<Rigid3d> base_from_cam;
   bool has_groundtruth = false;
+  // "file:line" of odometry samples dropped as jumps (JumpPolicy::kDrop).
+  std::vector<std::string> dropped_odometry_lines;
 
   // Loads frame i as 8-bit grey (color=false) or BGR. Throws InputError
   // naming the image if it is unreadable or not of the camera's size.

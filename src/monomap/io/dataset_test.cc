@@ -1,6 +1,7 @@
 #include "monomap/io/dataset.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
@@ -13,10 +14,23 @@ namespace {
 namespace fs = std::filesystem;
 
 // Writes a 3-frame dataset; `odometry` replaces odometry.txt if non-empty.
+// Removes the test datasets when the test program ends.
+struct TempDirs {
+  std::vector<fs::path> dirs;
+  ~TempDirs() {
+    std::error_code ec;
+    for (const fs::path& d : dirs) fs::remove_all(d, ec);
+  }
+};
+TempDirs temp_dirs;
+
 fs::path MakeDataset(const std::string& name, const std::string& odometry = "",
                      int image_width = 64) {
-  const fs::path dir = fs::temp_directory_path() / ("monomap_io_" + name);
+  // Per process: other checkouts may run the same test at the same time.
+  const fs::path dir = fs::temp_directory_path() /
+                       ("monomap_io_" + name + "_" + std::to_string(getpid()));
   fs::remove_all(dir);
+  temp_dirs.dirs.push_back(dir);
   fs::create_directories(dir / "rgb");
   Camera c;
   c.width = 64;

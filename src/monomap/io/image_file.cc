@@ -2,13 +2,21 @@
 
 #include <algorithm>
 #include <array>
+#include <csetjmp>
 #include <cstdint>
-#include <fstream>
-#include <iterator>
+#include <cstdio>
+#include <cstdlib>
 #include <opencv2/imgcodecs.hpp>
+#include <string>
+#include <vector>
+
+// After <cstdio>: jpeglib.h needs FILE and size_t.
+#include <jpeglib.h>
+
 #include <vector>
 
 #include "monomap/util/error.h"
+#include "monomap/util/file.h"
 
 namespace monomap {
 namespace {
@@ -25,14 +33,118 @@ constexpr std::array<uint8_t, 12> kPngEnd = {
 // Writers may pad a JPEG after its end-of-image marker; look this far back.
 constexpr size_t kJpegTailBytes = 4096;
 
+uint32_t BigEndian(const std::vector<uint8_t>& data, size_t at, int bytes) {
+  uint32_t v = 0;
+  for (int i = 0; i < bytes; ++i) v = (v << 8) | data[at + i];
+  return v;
+}
+
+// Width and height from a PNG's IHDR chunk (right after the signature).
+bool PngSize(const std::vector<uint8_t>& data, int64_t* w, int64_t* h) {
+  if (data.size() < 24 || BigEndian(data, 12, 4) != 0x49484452) return false;
+  *w = BigEndian(data, 16, 4);
+  *h = BigEndian(data, 20, 4);
+  return true;
+}
+
+// Width and height from a JPEG's first start-of-frame marker.
+bool JpegSize(const std::vector<uint8_t>& data, int64_t* w, int64_t* h) {
+  size_t i = 2;
+  while (i + 9 < data.size()) {
+    if (data[i] != 0xFF) return false;
+    const uint8_t marker = data[i + 1];
+    if (marker == 0xFF) {  // fill byte
+      ++i;
+      continue;
+    }
+    const bool sof = marker >= 0xC0 && marker <= 0xCF && marker != 0xC4 &&
+                     marker != 0xC8 && marker != 0xCC;
+    if (sof) {
+      *h = BigEndian(data, i + 5, 2);
+      *w = BigEndian(data, i + 7, 2);
+      return true;
+    }
+    i += 2 + BigEndian(data, i + 2, 2);
+  }
+  return false;
+}
+
+// libjpeg's error handling: errors jump back to the caller, warnings (such
+// as "Premature end of JPEG file", after which libjpeg fills the missing
+// rows with grey) are counted and the first is kept, none is printed.
+struct JpegErrors {
+  jpeg_error_mgr manager;
+  std::jmp_buf jump;
+  char message[JMSG_LENGTH_MAX];
+};
+
+void JpegErrorExit(j_common_ptr cinfo) {
+  auto* errors = reinterpret_cast<JpegErrors*>(cinfo->err);
+  (*cinfo->err->format_message)(cinfo, errors->message);
+  std::longjmp(errors->jump, 1);
+}
+
+void JpegEmitMessage(j_common_ptr cinfo, int level) {
+  if (level >= 0) return;  // trace messages
+  auto* errors = reinterpret_cast<JpegErrors*>(cinfo->err);
+  if (cinfo->err->num_warnings++ == 0) {
+    (*cinfo->err->format_message)(cinfo, errors->message);
+  }
+}
+
+// Decodes the whole entropy-coded data of a JPEG (at 1/8 scale, which
+// still reads every block) and returns libjpeg's first error or warning,
+// "" if there is none. Plain C inside: no C++ object lives across the
+// setjmp.
+std::string JpegDecodeProblem(const std::vector<uint8_t>& data) {
+  jpeg_decompress_struct cinfo;
+  JpegErrors errors;
+  errors.message[0] = '\0';
+  cinfo.err = jpeg_std_error(&errors.manager);
+  errors.manager.error_exit = JpegErrorExit;
+  errors.manager.emit_message = JpegEmitMessage;
+  unsigned char* row = nullptr;
+  if (setjmp(errors.jump) != 0) {
+    std::free(row);
+    jpeg_destroy_decompress(&cinfo);
+    return errors.message;
+  }
+  jpeg_create_decompress(&cinfo);
+  jpeg_mem_src(&cinfo, data.data(), static_cast<unsigned long>(data.size()));
+  jpeg_read_header(&cinfo, TRUE);
+  cinfo.scale_num = 1;
+  cinfo.scale_denom = 8;
+  cinfo.dct_method = JDCT_IFAST;
+  cinfo.do_fancy_upsampling = FALSE;
+  jpeg_start_decompress(&cinfo);
+  row = static_cast<unsigned char*>(
+      std::malloc(cinfo.output_width * cinfo.output_components));
+  while (row != nullptr && cinfo.output_scanline < cinfo.output_height) {
+    JSAMPROW rows[1] = {row};
+    jpeg_read_scanlines(&cinfo, rows, 1);
+  }
+  if (row != nullptr) jpeg_finish_decompress(&cinfo);
+  std::free(row);
+  const bool warned = cinfo.err->num_warnings > 0;
+  jpeg_destroy_decompress(&cinfo);
+  return warned ? errors.message : "";
+}
+
 }  // namespace
 
+std::string ImageSizeLimitError(int64_t width, int64_t height) {
+  if (width > kMaxImageSide || height > kMaxImageSide ||
+      width * height > kMaxImagePixels) {
+    return "size " + std::to_string(width) + "x" + std::to_string(height) +
+           " exceeds the limit (sides up to " + std::to_string(kMaxImageSide) +
+           ", " + std::to_string(kMaxImagePixels) + " pixels)";
+  }
+  return "";
+}
+
 cv::Mat ReadImageFile(const std::filesystem::path& path, int flags) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path.string() + ": cannot open image");
-  const std::vector<uint8_t> data((std::istreambuf_iterator<char>(in)),
-                                  std::istreambuf_iterator<char>());
-  if (in.bad()) throw InputError(path.string() + ": cannot read image");
+  const std::string bytes = ReadFileToString(path);
+  const std::vector<uint8_t> data(bytes.begin(), bytes.end());
   if (data.empty()) throw InputError(path.string() + ": image file is empty");
   if (StartsWith(data, {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'})) {
     if (data.size() < kPngEnd.size() ||
@@ -53,7 +165,27 @@ cv::Mat ReadImageFile(const std::filesystem::path& path, int flags) {
                        ": truncated JPEG (no end-of-image marker)");
     }
   }
-  cv::Mat image = cv::imdecode(data, flags);
+  int64_t width = 0, height = 0;
+  const bool is_jpeg = JpegSize(data, &width, &height);
+  if (is_jpeg || PngSize(data, &width, &height)) {
+    const std::string error = ImageSizeLimitError(width, height);
+    if (!error.empty()) throw InputError(path.string() + ": image " + error);
+  }
+  if (is_jpeg) {
+    // An end marker appended to a truncated JPEG passes the check above;
+    // libjpeg then only warns and fills the missing part with grey.
+    const std::string problem = JpegDecodeProblem(data);
+    if (!problem.empty()) {
+      throw InputError(path.string() +
+                       ": JPEG does not decode completely: " + problem);
+    }
+  }
+  cv::Mat image;
+  try {
+    image = cv::imdecode(data, flags);
+  } catch (const cv::Exception& e) {  // e.g. OpenCV's own pixel limit
+    throw InputError(path.string() + ": cannot decode image: " + e.err);
+  }
   if (image.empty()) {
     throw InputError(path.string() + ": cannot decode image");
   }

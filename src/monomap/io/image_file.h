@@ -5,15 +5,27 @@
 // message. The end markers of both formats are checked first.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <opencv2/core.hpp>
+#include <string>
 
 namespace monomap {
 
+// Limits on decoded images (textures, dataset frames, map cameras): a small
+// compressed file can claim a huge size. docs/reliability.md.
+inline constexpr int kMaxImageSide = 16384;
+inline constexpr int64_t kMaxImagePixels = int64_t{64} << 20;  // 64 Mpx
+
+// "" if a width x height image is within the limits, else why not.
+std::string ImageSizeLimitError(int64_t width, int64_t height);
+
 // Decodes the image at `path` with cv::imdecode `flags`. Throws InputError
-// naming the file if it cannot be read, is a PNG without its IEND chunk or
-// a JPEG without its end-of-image marker, or cannot be decoded. Other
-// formats are left to OpenCV.
+// naming the file if it is not a regular file or cannot be read, is a PNG
+// without its IEND chunk or a JPEG without its end-of-image marker, claims
+// a size beyond the limits in its header (PNG, JPEG: checked before
+// decoding), or cannot be decoded. Other formats are left to OpenCV (whose
+// own pixel limit is turned into an InputError too).
 cv::Mat ReadImageFile(const std::filesystem::path& path, int flags);
 
 }  // namespace monomap

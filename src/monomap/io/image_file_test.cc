@@ -84,12 +84,60 @@ TEST_F(ImageFileTest, TruncatedFilesAreNamed) {
   EXPECT_NE(e.find(cut_png.string()), std::string::npos) << e;
   EXPECT_NE(e.find("truncated PNG"), std::string::npos) << e;
 
+  // Cut in half with an end marker appended: libjpeg alone would only warn
+  // ("premature end") and fill the rest with grey.
+  const fs::path patched =
+      Write(".jpg", static_cast<long>(jpg.size() / 2), {0xFF, 0xD9});
+  EXPECT_FALSE(cv::imread(patched.string(), cv::IMREAD_GRAYSCALE).empty());
+  e = Error(patched);
+  EXPECT_NE(e.find(patched.string()), std::string::npos) << e;
+  EXPECT_NE(e.find("does not decode completely"), std::string::npos) << e;
+  EXPECT_NE(e.find("premature end"), std::string::npos) << e;
+
   EXPECT_NE(Error(Write(".png", 0)).find("empty"), std::string::npos);
-  EXPECT_NE(Error(dir_ / "missing.png").find("cannot open"), std::string::npos);
+  EXPECT_NE(Error(dir_ / "missing.png").find("not found"), std::string::npos);
   // Not an image at all.
   const fs::path text = dir_ / "text.png";
   std::ofstream(text) << "not an image\n";
   EXPECT_NE(Error(text).find("cannot decode"), std::string::npos);
+}
+
+// Sizes are checked in the header, before anything is decoded.
+TEST_F(ImageFileTest, HugeHeadersAreRefusedBeforeDecoding) {
+  std::vector<uint8_t> png;
+  cv::imencode(".png", image_, png);
+  for (int i = 0; i < 4; ++i) {
+    png[16 + i] = static_cast<uint8_t>(30000u >> (24 - 8 * i));
+    png[20 + i] = static_cast<uint8_t>(30000u >> (24 - 8 * i));
+  }
+  const fs::path path = dir_ / "huge.png";
+  std::ofstream(path, std::ios::binary)
+      .write(reinterpret_cast<const char*>(png.data()),
+             static_cast<std::streamsize>(png.size()));
+  std::string e = Error(path);
+  EXPECT_NE(e.find("huge.png: image size 30000x30000 exceeds the limit"),
+            std::string::npos)
+      << e;
+  // JPEG: the height and width of the start-of-frame marker.
+  std::vector<uint8_t> jpg;
+  cv::imencode(".jpg", image_, jpg);
+  for (size_t i = 2; i + 8 < jpg.size();
+       i += 2 + (jpg[i + 2] << 8 | jpg[i + 3])) {
+    if (jpg[i + 1] == 0xC0) {
+      jpg[i + 5] = jpg[i + 7] = 0xEA;  // 60000
+      jpg[i + 6] = jpg[i + 8] = 0x60;
+      break;
+    }
+  }
+  const fs::path jpath = dir_ / "huge.jpg";
+  std::ofstream(jpath, std::ios::binary)
+      .write(reinterpret_cast<const char*>(jpg.data()),
+             static_cast<std::streamsize>(jpg.size()));
+  e = Error(jpath);
+  EXPECT_NE(e.find("image size 60000x60000 exceeds"), std::string::npos) << e;
+  EXPECT_EQ(ImageSizeLimitError(kMaxImageSide, kMaxImagePixels / kMaxImageSide),
+            "");
+  EXPECT_NE(ImageSizeLimitError(kMaxImageSide + 1, 1), "");
 }
 
 }  // namespace

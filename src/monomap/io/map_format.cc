@@ -90,6 +90,11 @@ class JsonFields {
     if (!value.is_number_integer()) {
       Fail(Join(parent, key), "expected an integer");
     }
+    if (value.is_number_unsigned() &&
+        value.get<uint64_t>() >
+            static_cast<uint64_t>(std::numeric_limits<int64_t>::max())) {
+      Fail(Join(parent, key), "out of range");
+    }
     return value.get<int64_t>();
   }
 
@@ -161,6 +166,10 @@ Camera ReadCamera(const JsonFields& f, const json& root) {
     f.Fail(camera.width <= 0 ? "camera.width" : "camera.height",
            "must be positive");
   }
+  // Checked before anything allocates an image of the camera's size.
+  const std::string size_error =
+      ImageSizeLimitError(camera.width, camera.height);
+  if (!size_error.empty()) f.Fail("camera", size_error);
   if (camera.fx <= 0) f.Fail("camera.fx", "must be positive");
   if (camera.fy <= 0) f.Fail("camera.fy", "must be positive");
   return camera;
@@ -171,6 +180,8 @@ TexturedPlane ReadPlane(const JsonFields& f, const json& p,
   if (!p.is_object()) f.Fail(field, "expected an object");
   TexturedPlane plane;
   plane.id = f.Int(p, field, "id");
+  // -1 means "no plane" in points.ply.
+  if (plane.id < 0) f.Fail(JsonFields::Join(field, "id"), "must be >= 0");
   plane.plane.normal = f.Vector<3>(p, field, "normal");
   const double normal_norm = plane.plane.normal.norm();
   if (std::abs(normal_norm - 1.0) > kMapUnitTolerance) {
@@ -247,7 +258,8 @@ TexturedPlane ReadPlane(const JsonFields& f, const json& p,
                               "' is not a plain file name in the map folder");
   }
   const fs::path full = dir / texture_path;
-  if (!fs::is_regular_file(full)) {
+  std::error_code ec;
+  if (!fs::is_regular_file(full, ec)) {
     f.Fail(texture_field, "texture file " + full.string() + " is missing");
   }
   plane.texture = ToBgra(ReadImageFile(full, cv::IMREAD_UNCHANGED));
@@ -301,7 +313,8 @@ std::string FormatMapJson(const Map& map) {
 }
 
 void WriteMap(const fs::path& dir, const Map& map) {
-  if (!fs::is_directory(dir)) {
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) {
     throw OutputError(dir.string() + ": map directory does not exist");
   }
   std::set<int> ids;
@@ -339,7 +352,9 @@ void WriteMap(const fs::path& dir, const Map& map) {
 
 Map ReadMap(const fs::path& dir) {
   const fs::path json_path = dir / kMapJsonFile;
-  if (!fs::is_regular_file(json_path)) {
+  // Anything else at the path (a FIFO, a symlink loop) is named by the
+  // reader below.
+  if (!PathExists(json_path)) {
     throw InputError(json_path.string() + ": missing (not a monomap map " +
                      "directory?)");
   }
@@ -347,7 +362,7 @@ Map ReadMap(const fs::path& dir) {
   json root;
   try {
     root = json::parse(ReadFileToString(json_path));
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {  // syntax, number overflow, ...
     throw InputError(json_path.string() + ": invalid JSON: " + e.what());
   }
   if (!root.is_object()) {
@@ -382,7 +397,7 @@ Map ReadMap(const fs::path& dir) {
   if (num_frames < 0) f.Fail("num_frames", "negative");
 
   const fs::path trajectory_path = dir / kMapTrajectoryFile;
-  if (!fs::is_regular_file(trajectory_path)) {
+  if (!PathExists(trajectory_path)) {
     throw InputError(trajectory_path.string() + ": missing");
   }
   // An empty trajectory file (no poses) is valid only for num_frames = 0.
@@ -395,7 +410,7 @@ Map ReadMap(const fs::path& dir) {
   }
 
   const fs::path points_path = dir / kMapPointsFile;
-  if (fs::exists(points_path)) {
+  if (PathExists(points_path)) {
     map.landmarks = ReadLandmarksPly(points_path);
     if (static_cast<int64_t>(map.landmarks.size()) != num_landmarks) {
       throw InputError(points_path.string() + ": has " +

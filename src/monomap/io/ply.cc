@@ -107,6 +107,42 @@ struct PlyHeader {
   size_t data_start = 0;  // byte offset of the first data byte
 };
 
+// Fewest bytes one row of `element` can take: binary, its scalars and list
+// lengths; ASCII, one character and a separator per value.
+uint64_t MinRowBytes(const PlyElement& element, PlyFormat format) {
+  uint64_t bytes = 0;
+  for (const PlyProperty& p : element.properties) {
+    bytes += format == PlyFormat::kAscii
+                 ? 2
+                 : TypeSize(p.is_list ? p.count_type : p.type);
+  }
+  return bytes;
+}
+
+// Bounds every element count by the data actually present, before any
+// loop or allocation: a small file cannot claim billions of rows.
+void CheckElementCounts(const PlyHeader& header, size_t data_bytes,
+                        const std::string& file) {
+  for (const PlyElement& element : header.elements) {
+    const uint64_t row_bytes = MinRowBytes(element, header.format);
+    const uint64_t count = static_cast<uint64_t>(element.count);
+    if (row_bytes == 0 && count > 0) {
+      throw InputError(file + ": PLY element '" + element.name + "' has " +
+                       std::to_string(count) + " rows but no properties");
+    }
+    // ASCII: the last value needs no separator.
+    const uint64_t slack = header.format == PlyFormat::kAscii ? 1 : 0;
+    if (row_bytes > 0 && count > (data_bytes + slack) / row_bytes) {
+      throw InputError(file + ": truncated PLY or bad count: element '" +
+                       element.name + "' count " + std::to_string(count) +
+                       " needs at least " + std::to_string(row_bytes) +
+                       " bytes per row, the file "
+                       "has only " +
+                       std::to_string(data_bytes) + " bytes of data");
+    }
+  }
+}
+
 PlyHeader ParseHeader(const std::string& data, const std::string& file) {
   PlyHeader header;
   size_t pos = 0;
@@ -194,6 +230,7 @@ PlyHeader ParseHeader(const std::string& data, const std::string& file) {
   }
   if (!have_format) throw InputError(file + ": PLY header has no format");
   header.data_start = pos;
+  CheckElementCounts(header, data.size() - pos, file);
   return header;
 }
 
@@ -257,6 +294,13 @@ class PlyDataReader {
               const double n = ReadValue(property.count_type, element, row);
               if (n < 0 || n != std::floor(n)) {
                 Fail(element, row, "negative or non-integer list length");
+              }
+              // Checked as a double: a cast of an out-of-range value to an
+              // integer is undefined. Each item takes at least one byte.
+              if (n > static_cast<double>(data_.size() - pos_)) {
+                Fail(element, row,
+                     "list length " + std::to_string(n) +
+                         " exceeds the data left in the file");
               }
               for (int64_t k = 0; k < static_cast<int64_t>(n); ++k) {
                 ReadValue(property.type, element, row);
@@ -379,6 +423,20 @@ std::vector<std::vector<double>> ReadVertexColumns(
   return columns;
 }
 
+// An integer id read as a double, checked to lie in [lo, hi] before the
+// cast (out of range, the cast would be undefined).
+double CheckedId(double v, double lo, double hi,
+                 const std::filesystem::path& path, const char* field,
+                 size_t row) {
+  if (!(v >= lo && v <= hi) || v != std::floor(v)) {
+    throw InputError(path.string() + ": vertex " + std::to_string(row) + ": '" +
+                     field + "' " + std::to_string(v) +
+                     " is not an integer in [" + std::to_string(lo) + ", " +
+                     std::to_string(hi) + "]");
+  }
+  return v;
+}
+
 }  // namespace
 
 std::vector<Eigen::Vector3d> ReadPlyPoints(const std::filesystem::path& path) {
@@ -404,9 +462,15 @@ std::vector<Landmark> ReadLandmarksPly(const std::filesystem::path& path) {
       l.color = Eigen::Vector3d(columns[3][i], columns[4][i], columns[5][i])
                     .cast<float>();
     }
-    l.id = columns[6].size() == n ? static_cast<FeatureId>(columns[6][i])
-                                  : static_cast<FeatureId>(i);
-    l.plane_id = columns[7].size() == n ? static_cast<int>(columns[7][i]) : -1;
+    l.id = columns[6].size() == n
+               ? static_cast<FeatureId>(
+                     CheckedId(columns[6][i], 0, 9.0e15, path, "feature_id", i))
+               : static_cast<FeatureId>(i);
+    l.plane_id = columns[7].size() == n
+                     ? static_cast<int>(CheckedId(
+                           columns[7][i], -1, std::numeric_limits<int>::max(),
+                           path, "plane", i))
+                     : -1;
   }
   return landmarks;
 }

@@ -189,5 +189,54 @@ TEST(PlyTest, RejectsTruncatedAndMalformedFiles) {
             std::string::npos);
 }
 
+// Counts a small file cannot hold are refused before any loop: these took
+// billions of iterations (or an undefined cast) before.
+TEST(PlyTest, CountsAreBoundedByTheFileSize) {
+  const fs::path path = TempFile("counts.ply");
+  // An element with a huge count and no properties, before the vertices.
+  WriteBytes(path,
+             "ply\nformat ascii 1.0\nelement junk 4000000000\n"
+             "element vertex 1\nproperty float x\nproperty float y\n"
+             "property float z\nend_header\n1 2 3\n");
+  std::string error = ErrorOf(path);
+  EXPECT_NE(error.find("counts.ply"), std::string::npos) << error;
+  EXPECT_NE(error.find("'junk'"), std::string::npos) << error;
+  EXPECT_NE(error.find("no properties"), std::string::npos) << error;
+
+  // ASCII: more rows than the data can hold.
+  WriteBytes(path,
+             "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
+             "property float y\nproperty float z\nend_header\n1 2 3\n4 5 6\n");
+  EXPECT_NE(ErrorOf(path).find("count 3 needs"), std::string::npos);
+  // ... while exactly enough data (no final newline) is fine.
+  WriteBytes(path,
+             "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\n"
+             "property float y\nproperty float z\nend_header\n1 2 3 4 5 6");
+  EXPECT_EQ(ReadPlyPoints(path).size(), 2u);
+
+  // A list length far beyond any integer, in ASCII.
+  WriteBytes(path,
+             "ply\nformat ascii 1.0\nelement face 1\n"
+             "property list uchar int idx\nelement vertex 1\n"
+             "property float x\nproperty float y\nproperty float z\n"
+             "end_header\n1e300 1\n1 2 3\n");
+  error = ErrorOf(path);
+  EXPECT_NE(error.find("list length"), std::string::npos) << error;
+  EXPECT_NE(error.find("'face' row 0"), std::string::npos) << error;
+
+  // Ids out of the range of their types.
+  WriteBytes(path,
+             "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n"
+             "property float y\nproperty float z\nproperty int plane\n"
+             "end_header\n1 2 3 1e300\n");
+  try {
+    ReadLandmarksPly(path);
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("'plane'"), std::string::npos)
+        << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace monomap

@@ -36,8 +36,10 @@ bool ParsePoseTokens(const std::vector<std::string>& tokens, size_t first,
 
 }  // namespace
 
-std::vector<TimedPose> ReadTumTrajectory(const std::filesystem::path& path) {
+std::vector<TimedPose> ReadTumTrajectory(const std::filesystem::path& path,
+                                         std::vector<int>* line_numbers) {
   std::vector<TimedPose> poses;
+  if (line_numbers != nullptr) line_numbers->clear();
   for (const TextLine& line : ReadDataLines(path)) {
     const auto tokens = SplitWhitespace(line.text);
     if (tokens.size() != 8) {
@@ -59,6 +61,7 @@ std::vector<TimedPose> ReadTumTrajectory(const std::filesystem::path& path) {
                        "timestamp " + tokens[0] + " does not increase");
     }
     poses.push_back(p);
+    if (line_numbers != nullptr) line_numbers->push_back(line.number);
   }
   if (poses.empty()) {
     throw InputError(path.string() + ": no poses in trajectory file");

@@ -12,8 +12,11 @@ namespace monomap {
 
 // Reads a TUM trajectory. Throws InputError naming file and line on a
 // malformed line, a non-finite value, a zero quaternion or a timestamp
-// that does not increase.
-std::vector<TimedPose> ReadTumTrajectory(const std::filesystem::path& path);
+// that does not increase. With `line_numbers`, also the 1-based line of
+// each pose.
+std::vector<TimedPose> ReadTumTrajectory(
+    const std::filesystem::path& path,
+    std::vector<int>* line_numbers = nullptr);
 
 // Formats poses as TUM lines (with a comment header).
 std::string FormatTumTrajectory(const std::vector<TimedPose>& poses,

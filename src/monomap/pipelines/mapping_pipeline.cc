@@ -376,7 +376,7 @@ nlohmann::json MappingReport::ToJson() const {
 
 void WriteMappingResult(const std::filesystem::path& dir,
                         const MappingResult& result) {
-  AtomicDirectory out(dir);
+  AtomicDirectory out(dir, "map");
   WriteMap(out.path(), result.map);
   WriteFeatureTable(out.path() / "features.csv", result.tracks);
   out.Commit();

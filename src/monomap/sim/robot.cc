@@ -139,16 +139,28 @@ std::vector<TimedPose2d> SampleRobotPath(const RobotPath& path,
       path.closed() ? std::fmod(options.start_offset_m, length)
                     : options.start_offset_m;
   const double span = path.closed() ? length : length - start;
+  // A closed path is driven lap after lap, as long as asked.
   auto base_pose = [&](double driven) {
     double s = start + driven;
-    if (path.closed() && s > length) s -= length;
+    if (path.closed()) s = std::fmod(s, length);
     return path.PoseAt(s);
   };
   const double step = options.speed_mps / options.rate_hz;
+  // An open path ends: more samples than it holds are refused, not cut.
   auto sample_count = [&](double driven_length) {
-    int n = static_cast<int>(std::floor(driven_length / step)) + 1;
-    if (max_samples > 0) n = std::min(n, max_samples);
-    return n;
+    const int n = static_cast<int>(std::floor(driven_length / step)) + 1;
+    if (max_samples <= 0) return n;
+    if (max_samples > n && !path.closed()) {
+      throw OptionsError(
+          "num_frames: " + std::to_string(max_samples) + " frames need " +
+          std::to_string((max_samples - 1) * step) +
+          " m of path, but the "
+          "open path has " +
+          std::to_string(driven_length) + " m (at most " + std::to_string(n) +
+          " frames at this speed and rate); lower the "
+          "speed or the number of frames");
+    }
+    return max_samples;
   };
 
   const double d = options.lateral_offset_m;
@@ -192,7 +204,8 @@ std::vector<TimedPose2d> SampleRobotPath(const RobotPath& path,
   const int n = sample_count(table_offset[m]);
   std::vector<TimedPose2d> out(n);
   for (int k = 0; k < n; ++k) {
-    const double target = std::min(k * step, table_offset[m]);
+    const double target = path.closed() ? std::fmod(k * step, table_offset[m])
+                                        : std::min(k * step, table_offset[m]);
     const auto it =
         std::lower_bound(table_offset.begin(), table_offset.end(), target);
     const size_t i = std::clamp<size_t>(it - table_offset.begin(), 1,

@@ -83,7 +83,9 @@ class RobotPath {
 
 // Samples the path at options.rate_hz and constant speed from
 // options.start_offset_m to the end (loops are driven once), offset
-// options.lateral_offset_m to the left. max_samples > 0 truncates. Throws
+// options.lateral_offset_m to the left. max_samples > 0 gives exactly that
+// many samples: a loop is driven lap after lap; an open path too short for
+// them throws OptionsError (with the most it holds). Also throws
 // OptionsError if the start offset is not shorter than an open path, or if
 // the lateral offset reaches a turn's centre (the offset curve would turn
 // back on itself).

@@ -155,6 +155,39 @@ TEST(RobotTest, StartOffsetOnAStraightPath) {
   EXPECT_THROW(SampleRobotPath(path, o), OptionsError);
 }
 
+// Any requested length: a loop is driven lap after lap; an open path too
+// short is refused with the most it holds (it used to stop silently).
+TEST(RobotTest, RequestedLengthIsMetOrRefused) {
+  RobotPathOptions o;
+  const double step = o.speed_mps / o.rate_hz;
+  const RobotPath line({{0, 0}, {10, 0}}, false);
+  const int most = static_cast<int>(std::floor(10.0 / step)) + 1;
+  EXPECT_EQ(SampleRobotPath(line, o, most).size(), static_cast<size_t>(most));
+  try {
+    SampleRobotPath(line, o, most + 1);
+    FAIL() << "expected OptionsError";
+  } catch (const OptionsError& e) {
+    EXPECT_NE(std::string(e.what()).find("at most " + std::to_string(most)),
+              std::string::npos)
+        << e.what();
+  }
+  const RobotPath square({{0, 0}, {2, 0}, {2, 2}, {0, 2}}, true);
+  for (const double offset : {0.0, 0.2}) {
+    SCOPED_TRACE(offset);
+    o.lateral_offset_m = offset;
+    const int lap = static_cast<int>(SampleRobotPath(square, o).size());
+    const auto poses = SampleRobotPath(square, o, 3 * lap);
+    ASSERT_EQ(poses.size(), static_cast<size_t>(3 * lap));
+    // Constant speed all along, across the lap boundaries too.
+    for (size_t k = 1; k < poses.size(); ++k) {
+      const double d = std::hypot(poses[k].pose.x - poses[k - 1].pose.x,
+                                  poses[k].pose.y - poses[k - 1].pose.y);
+      EXPECT_NEAR(d, step, 0.05 * step) << k;
+      EXPECT_GT(poses[k].timestamp, poses[k - 1].timestamp);
+    }
+  }
+}
+
 TEST(RobotTest, LateralOffsetOnAStraightPathIsToTheLeft) {
   const RobotPath path({{0, 0}, {0, 10}}, false);  // heading +y: left is -x
   RobotPathOptions o;

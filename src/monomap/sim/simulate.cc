@@ -146,7 +146,7 @@ SimulationReport Simulate(const SimulationOptions& options,
                                    1));
   }
 
-  AtomicDirectory dir(out_dir);
+  AtomicDirectory dir(out_dir, "dataset");
   const fs::path root = dir.path();
   fs::create_directories(root / "rgb");
   WriteCameraYaml(root / "camera.yaml", camera, "monomap_sim_" + world.name);
