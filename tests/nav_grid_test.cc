@@ -1,8 +1,8 @@
 // The navigation grid of a simulated world's true planes, read back from
 // the written map.yaml + map.pgm, against the world's true walls.
-#include <filesystem>
-
 #include <gtest/gtest.h>
+
+#include <filesystem>
 
 #include "monomap/geometry/polygon.h"
 #include "monomap/io/nav_grid_export.h"
@@ -26,10 +26,12 @@ struct Truth {
   double Distance(const Vector2d& p) const {
     double d = INFINITY;
     for (const auto& [a, b] : segments) {
-      const double t = std::clamp((p - a).dot(b - a) / (b - a).squaredNorm(), 0.0, 1.0);
+      const double t =
+          std::clamp((p - a).dot(b - a) / (b - a).squaredNorm(), 0.0, 1.0);
       d = std::min(d, (a + t * (b - a) - p).norm());
     }
-    for (const Polygon2d& area : areas) d = std::min(d, DistanceToPolygon(area, p));
+    for (const Polygon2d& area : areas)
+      d = std::min(d, DistanceToPolygon(area, p));
     return d;
   }
 };
@@ -105,8 +107,10 @@ Figures Measure(const NavGrid& grid, const Truth& truth) {
     const int n = static_cast<int>(std::ceil((b - a).norm() / (0.25 * res)));
     for (int k = 0; k <= n; ++k) {
       const Vector2d p = a + (b - a) * (double(k) / n);
-      const int c = static_cast<int>(std::floor((p.x() - grid.origin.x()) / res));
-      const int row = static_cast<int>(std::floor((p.y() - grid.origin.y()) / res));
+      const int c =
+          static_cast<int>(std::floor((p.x() - grid.origin.x()) / res));
+      const int row =
+          static_cast<int>(std::floor((p.y() - grid.origin.y()) / res));
       bool hit = false;
       for (int dr = -1; dr <= 1; ++dr) {
         for (int dc = -1; dc <= 1; ++dc) {
@@ -145,12 +149,13 @@ TEST(NavGridTest, TrueWallsOfEveryWorldWithinOneCell) {
       EXPECT_GT(report.num_occupied, 0);
 
       const Figures f = Measure(grid, TruthOf(world, options));
-      std::printf("%-10s %.2f m: wall cells <= %.2f cells from truth, %.1f%% "
-                  "of wall length covered, %.1f%% of interior floor free, "
-                  "%.2f%% free cells off the floor\n",
-                  name.c_str(), resolution, f.max_wall_cell_distance_cells,
-                  100 * f.wall_length_covered, 100 * f.interior_floor_free,
-                  100 * f.free_outside_floor);
+      std::printf(
+          "%-10s %.2f m: wall cells <= %.2f cells from truth, %.1f%% "
+          "of wall length covered, %.1f%% of interior floor free, "
+          "%.2f%% free cells off the floor\n",
+          name.c_str(), resolution, f.max_wall_cell_distance_cells,
+          100 * f.wall_length_covered, 100 * f.interior_floor_free,
+          100 * f.free_outside_floor);
       EXPECT_LE(f.max_wall_cell_distance_cells, 1.0);
       EXPECT_GE(f.wall_length_covered, 0.99);
       EXPECT_GE(f.interior_floor_free, 0.99);
@@ -198,7 +203,8 @@ TEST(NavGridTest, BadOptionsAndEmptyMapsAreRejected) {
     ReadNavGrid(dir / "map.yaml");
     FAIL();
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("origin"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("origin"), std::string::npos)
+        << e.what();
   }
 }
 

@@ -84,7 +84,8 @@ class LineReader {
   }
   int64_t Int(const std::string& token, const char* field) const {
     int64_t v = 0;
-    const auto r = std::from_chars(token.data(), token.data() + token.size(), v);
+    const auto r =
+        std::from_chars(token.data(), token.data() + token.size(), v);
     if (r.ec != std::errc() || r.ptr != token.data() + token.size()) {
       Fail(std::string(field) + " '" + token + "' is not an integer");
     }
@@ -190,24 +191,24 @@ void CheckConsistency(const fs::path& dir, const ColmapModel& model) {
   std::unordered_map<int, const ColmapModel::Image*> images;
   for (const auto& im : model.images) {
     if (!camera_ids.count(im.camera_id)) {
-      throw InputError((dir / kImagesFile).string(), "image " +
-                       std::to_string(im.id), "unknown CAMERA_ID " +
-                       std::to_string(im.camera_id));
+      throw InputError((dir / kImagesFile).string(),
+                       "image " + std::to_string(im.id),
+                       "unknown CAMERA_ID " + std::to_string(im.camera_id));
     }
     images[im.id] = &im;
   }
   for (const auto& p : model.points) {
     for (const auto& e : p.track) {
       const auto it = images.find(e.image_id);
-      const bool ok = it != images.end() && e.point2d_idx >= 0 &&
-                      e.point2d_idx <
-                          static_cast<int>(it->second->points2d.size()) &&
-                      it->second->points2d[e.point2d_idx].point3d_id == p.id;
+      const bool ok =
+          it != images.end() && e.point2d_idx >= 0 &&
+          e.point2d_idx < static_cast<int>(it->second->points2d.size()) &&
+          it->second->points2d[e.point2d_idx].point3d_id == p.id;
       if (!ok) {
         throw InputError((dir / kPointsFile).string(),
                          "point " + std::to_string(p.id),
-                         "track element (" + std::to_string(e.image_id) +
-                             ", " + std::to_string(e.point2d_idx) +
+                         "track element (" + std::to_string(e.image_id) + ", " +
+                             std::to_string(e.point2d_idx) +
                              ") does not name a 2D point of this point");
       }
     }
@@ -238,8 +239,8 @@ ColmapModel::Camera ColmapCameraFromCamera(const Camera& camera, int id) {
     c.params = {camera.fx, camera.fy, cx, cy, d[0], d[1], d[2], d[3]};
   } else {
     c.model = "FULL_OPENCV";
-    c.params = {camera.fx, camera.fy, cx, cy, d[0], d[1],
-                d[2],      d[3],      d[4], 0.0,  0.0,  0.0};
+    c.params = {camera.fx, camera.fy, cx,   cy,  d[0], d[1],
+                d[2],      d[3],      d[4], 0.0, 0.0,  0.0};
   }
   return c;
 }
@@ -316,7 +317,8 @@ ColmapModel MakeColmapModel(const Map& map, const std::vector<Track>& tracks,
     p.id = l.id;
     p.xyz = l.x_in_world;
     for (int k = 0; k < 3; ++k) {
-      p.rgb[k] = static_cast<int>(std::lround(std::clamp(l.color[k], 0.f, 255.f)));
+      p.rgb[k] =
+          static_cast<int>(std::lround(std::clamp(l.color[k], 0.f, 255.f)));
     }
     const auto it = track_of.find(l.id);
     static const std::vector<Observation> kNone;
@@ -357,13 +359,14 @@ void WriteColmapText(const fs::path& dir, const ColmapModel& model) {
   std::error_code ec;
   fs::create_directories(dir, ec);
   if (ec) {
-    throw OutputError(dir.string() + ": cannot create directory: " +
-                      ec.message());
+    throw OutputError(dir.string() +
+                      ": cannot create directory: " + ec.message());
   }
   std::string cameras =
       "# Camera list with one line of data per camera:\n"
       "#   CAMERA_ID, MODEL, WIDTH, HEIGHT, PARAMS[]\n"
-      "# Number of cameras: " + std::to_string(model.cameras.size()) + "\n";
+      "# Number of cameras: " +
+      std::to_string(model.cameras.size()) + "\n";
   for (const auto& c : model.cameras) {
     cameras += std::to_string(c.id) + " " + c.model + " " +
                std::to_string(c.width) + " " + std::to_string(c.height);
@@ -374,7 +377,8 @@ void WriteColmapText(const fs::path& dir, const ColmapModel& model) {
       "# Image list with two lines of data per image:\n"
       "#   IMAGE_ID, QW, QX, QY, QZ, TX, TY, TZ, CAMERA_ID, NAME\n"
       "#   POINTS2D[] as (X, Y, POINT3D_ID)\n"
-      "# Number of images: " + std::to_string(model.images.size()) + "\n";
+      "# Number of images: " +
+      std::to_string(model.images.size()) + "\n";
   for (const auto& im : model.images) {
     const Eigen::Quaterniond& q = im.cam_from_world_rotation;
     const Eigen::Vector3d& t = im.cam_from_world_translation;
@@ -394,7 +398,8 @@ void WriteColmapText(const fs::path& dir, const ColmapModel& model) {
       "# 3D point list with one line of data per point:\n"
       "#   POINT3D_ID, X, Y, Z, R, G, B, ERROR, TRACK[] as "
       "(IMAGE_ID, POINT2D_IDX)\n"
-      "# Number of points: " + std::to_string(model.points.size()) + "\n";
+      "# Number of points: " +
+      std::to_string(model.points.size()) + "\n";
   for (const auto& p : model.points) {
     points += std::to_string(p.id);
     AppendNumbers({p.xyz.x(), p.xyz.y(), p.xyz.z()}, &points);

@@ -7,13 +7,12 @@
 // so principal points and 2D points are shifted by +0.5 on export.
 #pragma once
 
+#include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <cstdint>
 #include <filesystem>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
-#include <Eigen/Geometry>
 
 #include "monomap/map/map.h"
 

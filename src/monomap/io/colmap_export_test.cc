@@ -1,12 +1,12 @@
 #include "monomap/io/colmap_export.h"
 
+#include <gtest/gtest.h>
+
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <random>
 #include <regex>
-
-#include <gtest/gtest.h>
 
 #include "monomap/util/error.h"
 #include "monomap/util/file.h"
@@ -45,7 +45,8 @@ Scene MakeScene(const std::array<double, 5>& distortion, double noise_px) {
     const Eigen::Quaterniond wobble(
         Eigen::AngleAxisd(0.02 * f, Eigen::Vector3d(0.3, 1, 0.2).normalized()));
     s.map.trajectory.push_back(
-        {0.1 * f, Rigid3d(wobble * q, Eigen::Vector3d(0.2 * f, 0.05 * f, 1.0))});
+        {0.1 * f,
+         Rigid3d(wobble * q, Eigen::Vector3d(0.2 * f, 0.05 * f, 1.0))});
   }
   for (int i = 0; i < 60; ++i) {
     Landmark l;
@@ -138,12 +139,13 @@ TEST(ColmapExportTest, RoundTripKeepsPosesPointsAndTracks) {
       const Rigid3d world_from_cam =
           Rigid3d(im.cam_from_world_rotation, im.cam_from_world_translation)
               .Inverse();
-      max_pose_error = std::max(
-          {max_pose_error,
-           (world_from_cam.translation -
-            s.map.trajectory[f].world_from_cam.translation).norm(),
-           world_from_cam.rotation.angularDistance(
-               s.map.trajectory[f].world_from_cam.rotation)});
+      max_pose_error =
+          std::max({max_pose_error,
+                    (world_from_cam.translation -
+                     s.map.trajectory[f].world_from_cam.translation)
+                        .norm(),
+                    world_from_cam.rotation.angularDistance(
+                        s.map.trajectory[f].world_from_cam.rotation)});
       observations += im.points2d.size();
     }
     EXPECT_LT(max_pose_error, 1e-12);
@@ -217,8 +219,7 @@ TEST(ColmapExportTest, BadInputNamesFileAndLine) {
     EXPECT_NE(std::string(e.what()).find("cameras.txt:2"), std::string::npos)
         << e.what();
   }
-  EXPECT_THROW(MakeColmapModel(s.map, s.tracks, {"only_one.png"}),
-               OutputError);
+  EXPECT_THROW(MakeColmapModel(s.map, s.tracks, {"only_one.png"}), OutputError);
 }
 
 // Runs `colmap ARGS` with output to `log`; returns the exit status.

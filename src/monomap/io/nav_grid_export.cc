@@ -1,12 +1,12 @@
 #include "monomap/io/nav_grid_export.h"
 
+#include <yaml-cpp/yaml.h>
+
 #include <charconv>
 #include <cmath>
-#include <vector>
-
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
-#include <yaml-cpp/yaml.h>
+#include <vector>
 
 #include "monomap/geometry/polygon.h"
 #include "monomap/util/error.h"
@@ -72,17 +72,16 @@ std::string Number(double v) {
 void NavGridOptions::Check() const {
   CheckOption(resolution_m > 0 && std::isfinite(resolution_m),
               "nav_grid.resolution_m", "must be > 0");
-  CheckOption(std::isfinite(min_z_m) && std::isfinite(max_z_m) &&
-                  min_z_m < max_z_m,
-              "nav_grid.min_z_m", "the height band needs min_z_m < max_z_m");
+  CheckOption(
+      std::isfinite(min_z_m) && std::isfinite(max_z_m) && min_z_m < max_z_m,
+      "nav_grid.min_z_m", "the height band needs min_z_m < max_z_m");
   CheckOption(horizontal_max_tilt_deg >= 0 && horizontal_max_tilt_deg < 90,
               "nav_grid.horizontal_max_tilt_deg", "must be in [0, 90)");
   CheckOption(margin_m >= 0 && std::isfinite(margin_m), "nav_grid.margin_m",
               "must be >= 0");
-  CheckOption(free_thresh >= 0 && free_thresh < occupied_thresh &&
-                  occupied_thresh <= 1,
-              "nav_grid.free_thresh",
-              "needs 0 <= free_thresh < occupied_thresh <= 1");
+  CheckOption(
+      free_thresh >= 0 && free_thresh < occupied_thresh && occupied_thresh <= 1,
+      "nav_grid.free_thresh", "needs 0 <= free_thresh < occupied_thresh <= 1");
   // The fixed PGM values must read back as what they mean.
   CheckOption((255.0 - kPgmUnknown) / 255.0 >= free_thresh &&
                   (255.0 - kPgmUnknown) / 255.0 <= occupied_thresh &&
@@ -113,27 +112,30 @@ NavGrid MakeNavGrid(const Map& map, const NavGridOptions& options,
     }
   }
   if (r.num_floor_planes + r.num_obstacle_planes == 0) {
-    throw StageError("navigation grid: no floor plane below z = " +
-                     Number(options.min_z_m) +
-                     " m and no plane in the height band");
+    throw StageError(
+        "navigation grid: no floor plane below z = " + Number(options.min_z_m) +
+        " m and no plane in the height band");
   }
   NavGrid grid;
   const double res = options.resolution_m;
   grid.resolution_m = res;
   grid.origin = ((lo.array() - options.margin_m) / res).floor() * res;
-  const Eigen::Vector2d size = (hi.array() + options.margin_m - grid.origin.array()) / res;
+  const Eigen::Vector2d size =
+      (hi.array() + options.margin_m - grid.origin.array()) / res;
   const int cols = static_cast<int>(std::ceil(size.x()));
   const int rows = static_cast<int>(std::ceil(size.y()));
   if (cols > options.max_cells_per_side || rows > options.max_cells_per_side) {
     throw StageError("navigation grid: " + std::to_string(cols) + " x " +
-                     std::to_string(rows) + " cells exceeds max_cells_per_side " +
+                     std::to_string(rows) +
+                     " cells exceeds max_cells_per_side " +
                      std::to_string(options.max_cells_per_side));
   }
   grid.cells = cv::Mat1b(std::max(rows, 1), std::max(cols, 1),
                          static_cast<uint8_t>(NavCell::kUnknown));
   auto mark = [&](const Eigen::Vector3d& x, NavCell value) {
     const int c = static_cast<int>(std::floor((x.x() - grid.origin.x()) / res));
-    const int row = static_cast<int>(std::floor((x.y() - grid.origin.y()) / res));
+    const int row =
+        static_cast<int>(std::floor((x.y() - grid.origin.y()) / res));
     if (c < 0 || row < 0 || c >= grid.cells.cols || row >= grid.cells.rows) {
       return;
     }
@@ -173,10 +175,10 @@ void WriteNavGrid(const fs::path& dir, const NavGrid& grid,
     for (int c = 0; c < grid.cells.cols; ++c) {
       const NavCell v = grid.At(c, row);
       // Image row 0 is the top of the map: the highest y.
-      image(grid.cells.rows - 1 - row, c) =
-          v == NavCell::kOccupied ? kPgmOccupied
-          : v == NavCell::kFree   ? kPgmFree
-                                  : kPgmUnknown;
+      image(grid.cells.rows - 1 - row, c) = v == NavCell::kOccupied
+                                                ? kPgmOccupied
+                                            : v == NavCell::kFree ? kPgmFree
+                                                                  : kPgmUnknown;
     }
   }
   std::vector<uchar> pgm;
@@ -188,10 +190,10 @@ void WriteNavGrid(const fs::path& dir, const NavGrid& grid,
   if (ec) throw OutputError(dir.string() + ": " + ec.message());
   const std::string yaml =
       std::string("# ROS map_server occupancy grid written by monomap\n") +
-      "image: " + kPgmName + "\nmode: trinary\nresolution: " +
-      Number(grid.resolution_m) + "\norigin: [" + Number(grid.origin.x()) +
-      ", " + Number(grid.origin.y()) + ", 0.0]\nnegate: 0\noccupied_thresh: " +
-      Number(options.occupied_thresh) +
+      "image: " + kPgmName +
+      "\nmode: trinary\nresolution: " + Number(grid.resolution_m) +
+      "\norigin: [" + Number(grid.origin.x()) + ", " + Number(grid.origin.y()) +
+      ", 0.0]\nnegate: 0\noccupied_thresh: " + Number(options.occupied_thresh) +
       "\nfree_thresh: " + Number(options.free_thresh) + "\n";
   WriteFileAtomic(dir / kPgmName, std::string(pgm.begin(), pgm.end()));
   WriteFileAtomic(dir / kYamlName, yaml);
@@ -228,24 +230,27 @@ NavGrid ReadNavGrid(const fs::path& yaml_path) {
   }
   if (origin.size() != 3) throw InputError(file, "origin", "needs [x, y, yaw]");
   if (origin[2] != 0.0) {
-    throw InputError(file, "origin", "a rotated grid (yaw != 0) is not supported");
+    throw InputError(file, "origin",
+                     "a rotated grid (yaw != 0) is not supported");
   }
-  if (!(grid.resolution_m > 0)) throw InputError(file, "resolution", "must be > 0");
+  if (!(grid.resolution_m > 0))
+    throw InputError(file, "resolution", "must be > 0");
   grid.origin = {origin[0], origin[1]};
-  const fs::path image_path =
-      fs::path(image).is_absolute() ? fs::path(image)
-                                    : yaml_path.parent_path() / image;
-  const cv::Mat1b pixels = cv::imread(image_path.string(), cv::IMREAD_GRAYSCALE);
+  const fs::path image_path = fs::path(image).is_absolute()
+                                  ? fs::path(image)
+                                  : yaml_path.parent_path() / image;
+  const cv::Mat1b pixels =
+      cv::imread(image_path.string(), cv::IMREAD_GRAYSCALE);
   if (pixels.empty()) throw InputError(file, "image", "cannot read " + image);
   grid.cells.create(pixels.rows, pixels.cols);
   for (int row = 0; row < pixels.rows; ++row) {
     for (int c = 0; c < pixels.cols; ++c) {
       const double v = pixels(pixels.rows - 1 - row, c);
       const double p = negate ? v / 255.0 : (255.0 - v) / 255.0;
-      grid.cells(row, c) = static_cast<uint8_t>(
-          p > occupied ? NavCell::kOccupied
-          : p < free   ? NavCell::kFree
-                       : NavCell::kUnknown);
+      grid.cells(row, c) =
+          static_cast<uint8_t>(p > occupied ? NavCell::kOccupied
+                               : p < free   ? NavCell::kFree
+                                            : NavCell::kUnknown);
     }
   }
   return grid;

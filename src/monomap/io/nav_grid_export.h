@@ -7,11 +7,10 @@
 // docs/map-format.md, "Navigation grid".
 #pragma once
 
-#include <filesystem>
-#include <string>
-
 #include <Eigen/Core>
+#include <filesystem>
 #include <opencv2/core.hpp>
+#include <string>
 
 #include "monomap/map/map.h"
 
