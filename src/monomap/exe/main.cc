@@ -5,10 +5,31 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
+#include <string>
 
 #include "monomap/exe/commands.h"
 #include "monomap/util/error.h"
 #include "monomap/util/runtime.h"
+#include "monomap/version.h"
+
+namespace {
+
+// CLI11 reports an unknown first word only as "A subcommand is required":
+// name it and list the subcommands instead. Returns false if it is unknown.
+bool CheckSubcommandName(CLI::App& app, int argc, char** argv) {
+  if (argc < 2 || argv[1][0] == '-') return true;
+  std::string names;
+  for (const CLI::App* sub :
+       app.get_subcommands([](CLI::App*) { return true; })) {
+    if (sub->get_name() == argv[1]) return true;
+    names += (names.empty() ? "" : ", ") + sub->get_name();
+  }
+  std::fprintf(stderr, "monomap: error: unknown subcommand '%s' (one of: %s)\n",
+               argv[1], names.c_str());
+  return false;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   // One OpenCV thread (oneTBB does the parallelism) and an allocator that
@@ -18,6 +39,9 @@ int main(int argc, char** argv) {
       "monomap: dense planar maps and localization from one camera and "
       "odometry"};
   app.require_subcommand(1);
+  app.set_version_flag("--version", std::string("monomap ") +
+                                        monomap::kVersion + " (commit " +
+                                        monomap::kGitCommit + ")");
   monomap::RegisterBuildCommand(app);
   monomap::RegisterEvalCommand(app);
   monomap::RegisterSimulateCommand(app);
@@ -25,6 +49,8 @@ int main(int argc, char** argv) {
   monomap::RegisterLocalizeCommand(app);
   monomap::RegisterCalibrateCommand(app);
   monomap::RegisterDemoCommand(app);
+  monomap::RegisterExportCommand(app);
+  if (!CheckSubcommandName(app, argc, argv)) return 2;
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
