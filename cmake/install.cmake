@@ -71,10 +71,13 @@ if(HELP2MAN_EXECUTABLE AND TARGET monomap)
   add_custom_command(
     OUTPUT ${monomap_man}
     COMMAND ${CMAKE_COMMAND} -E make_directory ${PROJECT_BINARY_DIR}/man
+    COMMAND bash ${PROJECT_SOURCE_DIR}/scripts/man_subcommands.sh
+            $<TARGET_FILE:monomap> ${PROJECT_BINARY_DIR}/man/subcommands.h2m
     COMMAND ${HELP2MAN_EXECUTABLE} --no-info --version-option=--version
-            "--name=dense planar maps and localization from one camera and odometry" --output=${monomap_man}
+            "--name=dense planar maps and localization from one camera and odometry" --include=${PROJECT_BINARY_DIR}/man/subcommands.h2m
+            --output=${monomap_man}
             $<TARGET_FILE:monomap>
-    DEPENDS monomap
+    DEPENDS monomap ${PROJECT_SOURCE_DIR}/scripts/man_subcommands.sh
     COMMENT "Generating the monomap(1) man page with help2man"
     VERBATIM)
   add_custom_target(man ALL DEPENDS ${monomap_man})
