@@ -56,6 +56,24 @@ std::vector<std::string> ImageNames(const Map& map, const fs::path& dataset) {
   return names;
 }
 
+// The COLMAP model of the map, with the tracks of its features.csv.
+ColmapModel ColmapOfMap(const ExportArgs& a, const Map& map,
+                        ColmapExportReport* report) {
+  const fs::path features = fs::path(a.map_dir) / "features.csv";
+  const std::vector<Track> tracks =
+      fs::exists(features) ? ReadFeatureTable(features) : std::vector<Track>();
+  if (tracks.empty()) {
+    std::fprintf(stderr,
+                 "monomap: warning: %s missing or empty: COLMAP "
+                 "points get no tracks\n",
+                 features.c_str());
+  }
+  const std::vector<std::string> names =
+      a.images_dataset.empty() ? std::vector<std::string>()
+                               : ImageNames(map, a.images_dataset);
+  return MakeColmapModel(map, tracks, names, report);
+}
+
 void RunExport(const ExportArgs& a) {
   if (a.colmap_dir.empty() && a.nav_grid_dir.empty() && a.glb_path.empty()) {
     throw OptionsError(
@@ -72,20 +90,7 @@ void RunExport(const ExportArgs& a) {
   std::optional<ColmapModel> colmap;
   ColmapExportReport colmap_report;
   if (!a.colmap_dir.empty()) {
-    const fs::path features = fs::path(a.map_dir) / "features.csv";
-    const std::vector<Track> tracks = fs::exists(features)
-                                          ? ReadFeatureTable(features)
-                                          : std::vector<Track>();
-    if (tracks.empty()) {
-      std::fprintf(stderr,
-                   "monomap: warning: %s missing or empty: COLMAP "
-                   "points get no tracks\n",
-                   features.c_str());
-    }
-    const std::vector<std::string> names =
-        a.images_dataset.empty() ? std::vector<std::string>()
-                                 : ImageNames(map, a.images_dataset);
-    colmap = MakeColmapModel(map, tracks, names, &colmap_report);
+    colmap = ColmapOfMap(a, map, &colmap_report);
   }
   std::optional<NavGrid> grid;
   NavGridReport grid_report;

@@ -221,6 +221,109 @@ std::string FrameName(int frame) {
   return buf;
 }
 
+// The 3D point of a landmark; its track's observations become 2D points of
+// `images`. Counts go to `report`, the sum of reprojection errors to
+// `error_sum`.
+ColmapModel::Point3D MakePoint(const Landmark& l, const Track* track,
+                               const Camera& camera,
+                               const std::vector<Rigid3d>& cam_from_world,
+                               std::vector<ColmapModel::Image>* images,
+                               ColmapExportReport* report, double* error_sum) {
+  ColmapModel::Point3D p;
+  p.id = l.id;
+  p.xyz = l.x_in_world;
+  for (int k = 0; k < 3; ++k) {
+    p.rgb[k] =
+        static_cast<int>(std::lround(std::clamp(l.color[k], 0.f, 255.f)));
+  }
+  if (track == nullptr) return p;
+  const int num_frames = static_cast<int>(cam_from_world.size());
+  double point_error = 0;
+  for (const Observation& o : track->observations) {
+    const Eigen::Vector3d x_in_cam =
+        o.frame >= 0 && o.frame < num_frames
+            ? cam_from_world[o.frame] * l.x_in_world
+            : Eigen::Vector3d::Zero();
+    if (!(x_in_cam.z() > 0)) {
+      ++report->num_dropped_observations;
+      continue;
+    }
+    point_error += (camera.ImageFromCam(x_in_cam) - o.px).norm();
+    ColmapModel::Image& im = (*images)[o.frame];
+    p.track.push_back({im.id, static_cast<int>(im.points2d.size())});
+    im.points2d.push_back(
+        {o.px + Eigen::Vector2d::Constant(kColmapPixelShift), l.id});
+  }
+  if (!p.track.empty()) {
+    p.error = point_error / p.track.size();
+    *error_sum += point_error;
+    report->num_observations += static_cast<int>(p.track.size());
+    ++report->num_points_with_track;
+  }
+  return p;
+}
+
+std::string FormatCameras(const ColmapModel& model) {
+  std::string cameras =
+      "# Camera list with one line of data per camera:\n"
+      "#   CAMERA_ID, MODEL, WIDTH, HEIGHT, PARAMS[]\n"
+      "# Number of cameras: " +
+      std::to_string(model.cameras.size()) + "\n";
+  for (const auto& c : model.cameras) {
+    cameras += std::to_string(c.id) + " " + c.model + " " +
+               std::to_string(c.width) + " " + std::to_string(c.height);
+    for (double v : c.params) AppendNumbers({v}, &cameras);
+    cameras += "\n";
+  }
+  return cameras;
+}
+
+std::string FormatImages(const ColmapModel& model) {
+  std::string images =
+      "# Image list with two lines of data per image:\n"
+      "#   IMAGE_ID, QW, QX, QY, QZ, TX, TY, TZ, CAMERA_ID, NAME\n"
+      "#   POINTS2D[] as (X, Y, POINT3D_ID)\n"
+      "# Number of images: " +
+      std::to_string(model.images.size()) + "\n";
+  for (const auto& im : model.images) {
+    const Eigen::Quaterniond& q = im.cam_from_world_rotation;
+    const Eigen::Vector3d& t = im.cam_from_world_translation;
+    images += std::to_string(im.id);
+    AppendNumbers({q.w(), q.x(), q.y(), q.z(), t.x(), t.y(), t.z()}, &images);
+    images += " " + std::to_string(im.camera_id) + " " + im.name + "\n";
+    for (size_t k = 0; k < im.points2d.size(); ++k) {
+      const auto& p = im.points2d[k];
+      if (k > 0) images += " ";
+      AppendNumber(p.xy.x(), &images);
+      AppendNumbers({p.xy.y()}, &images);
+      images += " " + std::to_string(p.point3d_id);
+    }
+    images += "\n";
+  }
+  return images;
+}
+
+std::string FormatPoints(const ColmapModel& model) {
+  std::string points =
+      "# 3D point list with one line of data per point:\n"
+      "#   POINT3D_ID, X, Y, Z, R, G, B, ERROR, TRACK[] as "
+      "(IMAGE_ID, POINT2D_IDX)\n"
+      "# Number of points: " +
+      std::to_string(model.points.size()) + "\n";
+  for (const auto& p : model.points) {
+    points += std::to_string(p.id);
+    AppendNumbers({p.xyz.x(), p.xyz.y(), p.xyz.z()}, &points);
+    for (int k = 0; k < 3; ++k) points += " " + std::to_string(p.rgb[k]);
+    AppendNumbers({p.error}, &points);
+    for (const auto& e : p.track) {
+      points += " " + std::to_string(e.image_id) + " " +
+                std::to_string(e.point2d_idx);
+    }
+    points += "\n";
+  }
+  return points;
+}
+
 }  // namespace
 
 ColmapModel::Camera ColmapCameraFromCamera(const Camera& camera, int id) {
@@ -313,39 +416,10 @@ ColmapModel MakeColmapModel(const Map& map, const std::vector<Track>& tracks,
       throw OutputError("COLMAP export: landmark id " + std::to_string(l.id) +
                         " repeated or negative");
     }
-    ColmapModel::Point3D p;
-    p.id = l.id;
-    p.xyz = l.x_in_world;
-    for (int k = 0; k < 3; ++k) {
-      p.rgb[k] =
-          static_cast<int>(std::lround(std::clamp(l.color[k], 0.f, 255.f)));
-    }
     const auto it = track_of.find(l.id);
-    static const std::vector<Observation> kNone;
-    double point_error = 0;
-    for (const Observation& o :
-         it == track_of.end() ? kNone : it->second->observations) {
-      const Eigen::Vector3d x_in_cam =
-          o.frame >= 0 && o.frame < num_frames
-              ? cam_from_world[o.frame] * l.x_in_world
-              : Eigen::Vector3d::Zero();
-      if (!(x_in_cam.z() > 0)) {
-        ++r.num_dropped_observations;
-        continue;
-      }
-      point_error += (map.camera.ImageFromCam(x_in_cam) - o.px).norm();
-      ColmapModel::Image& im = model.images[o.frame];
-      p.track.push_back({im.id, static_cast<int>(im.points2d.size())});
-      im.points2d.push_back(
-          {o.px + Eigen::Vector2d::Constant(kColmapPixelShift), l.id});
-    }
-    if (!p.track.empty()) {
-      p.error = point_error / p.track.size();
-      error_sum += point_error;
-      r.num_observations += static_cast<int>(p.track.size());
-      ++r.num_points_with_track;
-    }
-    model.points.push_back(std::move(p));
+    model.points.push_back(
+        MakePoint(l, it == track_of.end() ? nullptr : it->second, map.camera,
+                  cam_from_world, &model.images, &r, &error_sum));
   }
   r.num_images = num_frames;
   r.num_points = static_cast<int>(model.points.size());
@@ -362,58 +436,9 @@ void WriteColmapText(const fs::path& dir, const ColmapModel& model) {
     throw OutputError(dir.string() +
                       ": cannot create directory: " + ec.message());
   }
-  std::string cameras =
-      "# Camera list with one line of data per camera:\n"
-      "#   CAMERA_ID, MODEL, WIDTH, HEIGHT, PARAMS[]\n"
-      "# Number of cameras: " +
-      std::to_string(model.cameras.size()) + "\n";
-  for (const auto& c : model.cameras) {
-    cameras += std::to_string(c.id) + " " + c.model + " " +
-               std::to_string(c.width) + " " + std::to_string(c.height);
-    for (double v : c.params) AppendNumbers({v}, &cameras);
-    cameras += "\n";
-  }
-  std::string images =
-      "# Image list with two lines of data per image:\n"
-      "#   IMAGE_ID, QW, QX, QY, QZ, TX, TY, TZ, CAMERA_ID, NAME\n"
-      "#   POINTS2D[] as (X, Y, POINT3D_ID)\n"
-      "# Number of images: " +
-      std::to_string(model.images.size()) + "\n";
-  for (const auto& im : model.images) {
-    const Eigen::Quaterniond& q = im.cam_from_world_rotation;
-    const Eigen::Vector3d& t = im.cam_from_world_translation;
-    images += std::to_string(im.id);
-    AppendNumbers({q.w(), q.x(), q.y(), q.z(), t.x(), t.y(), t.z()}, &images);
-    images += " " + std::to_string(im.camera_id) + " " + im.name + "\n";
-    for (size_t k = 0; k < im.points2d.size(); ++k) {
-      const auto& p = im.points2d[k];
-      if (k > 0) images += " ";
-      AppendNumber(p.xy.x(), &images);
-      AppendNumbers({p.xy.y()}, &images);
-      images += " " + std::to_string(p.point3d_id);
-    }
-    images += "\n";
-  }
-  std::string points =
-      "# 3D point list with one line of data per point:\n"
-      "#   POINT3D_ID, X, Y, Z, R, G, B, ERROR, TRACK[] as "
-      "(IMAGE_ID, POINT2D_IDX)\n"
-      "# Number of points: " +
-      std::to_string(model.points.size()) + "\n";
-  for (const auto& p : model.points) {
-    points += std::to_string(p.id);
-    AppendNumbers({p.xyz.x(), p.xyz.y(), p.xyz.z()}, &points);
-    for (int k = 0; k < 3; ++k) points += " " + std::to_string(p.rgb[k]);
-    AppendNumbers({p.error}, &points);
-    for (const auto& e : p.track) {
-      points += " " + std::to_string(e.image_id) + " " +
-                std::to_string(e.point2d_idx);
-    }
-    points += "\n";
-  }
-  WriteFileAtomic(dir / kCamerasFile, cameras);
-  WriteFileAtomic(dir / kImagesFile, images);
-  WriteFileAtomic(dir / kPointsFile, points);
+  WriteFileAtomic(dir / kCamerasFile, FormatCameras(model));
+  WriteFileAtomic(dir / kImagesFile, FormatImages(model));
+  WriteFileAtomic(dir / kPointsFile, FormatPoints(model));
 }
 
 ColmapModel ReadColmapText(const fs::path& dir) {

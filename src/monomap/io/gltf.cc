@@ -131,6 +131,19 @@ void WriteMapGlb(const std::filesystem::path& path, const Map& map,
 
   tinygltf::Scene scene;
   scene.name = "monomap";
+  // Adds a mesh of one primitive and a scene node showing it.
+  auto add_mesh_node = [&](const std::string& name,
+                           const tinygltf::Primitive& primitive) {
+    tinygltf::Mesh mesh;
+    mesh.name = name;
+    mesh.primitives.push_back(primitive);
+    model.meshes.push_back(mesh);
+    tinygltf::Node node;
+    node.name = name;
+    node.mesh = static_cast<int>(model.meshes.size()) - 1;
+    model.nodes.push_back(node);
+    scene.nodes.push_back(static_cast<int>(model.nodes.size()) - 1);
+  };
   for (const TexturedPlane& plane : map.planes) {
     if (plane.polygon.size() < 3 || plane.texture.empty() ||
         !(plane.pixels_per_meter > 0)) {
@@ -210,16 +223,7 @@ void WriteMapGlb(const std::filesystem::path& path, const Map& map,
     model.materials.push_back(material);
     primitive.material = static_cast<int>(model.materials.size()) - 1;
 
-    tinygltf::Mesh mesh;
-    mesh.name = name;
-    mesh.primitives.push_back(primitive);
-    model.meshes.push_back(mesh);
-
-    tinygltf::Node node;
-    node.name = name;
-    node.mesh = static_cast<int>(model.meshes.size()) - 1;
-    model.nodes.push_back(node);
-    scene.nodes.push_back(static_cast<int>(model.nodes.size()) - 1);
+    add_mesh_node(name, primitive);
   }
   // A mesh node of one untextured primitive (camera path, points).
   auto add_node = [&](const std::string& name, int mode,
@@ -255,15 +259,7 @@ void WriteMapGlb(const std::filesystem::path& path, const Map& map,
     material.pbrMetallicRoughness.metallicFactor = 0.0;
     model.materials.push_back(material);
     primitive.material = static_cast<int>(model.materials.size()) - 1;
-    tinygltf::Mesh mesh;
-    mesh.name = name;
-    mesh.primitives.push_back(primitive);
-    model.meshes.push_back(mesh);
-    tinygltf::Node node;
-    node.name = name;
-    node.mesh = static_cast<int>(model.meshes.size()) - 1;
-    model.nodes.push_back(node);
-    scene.nodes.push_back(static_cast<int>(model.nodes.size()) - 1);
+    add_mesh_node(name, primitive);
   };
   if (options.camera_path) {
     std::vector<Eigen::Vector3f> centres;

@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <Eigen/Geometry>
 #include <charconv>
 #include <cmath>
 #include <opencv2/core.hpp>
@@ -61,6 +62,63 @@ void SamplePlane(const TexturedPlane& p, double step, Visit visit) {
   }
 }
 
+// Roles of all planes; the xy extent of the used ones and their counts.
+std::vector<PlaneRole> ClassifyPlanes(const Map& map, const NavGridOptions& o,
+                                      Eigen::AlignedBox2d* extent,
+                                      NavGridReport* r) {
+  std::vector<PlaneRole> roles;
+  for (const TexturedPlane& p : map.planes) {
+    roles.push_back(Classify(p, o));
+    if (roles.back() == PlaneRole::kIgnored) continue;
+    (roles.back() == PlaneRole::kFloor ? r->num_floor_planes
+                                       : r->num_obstacle_planes)++;
+    for (const Eigen::Vector2d& st : p.polygon) {
+      extent->extend(p.frame.ToWorld(st).head<2>());
+    }
+  }
+  return roles;
+}
+
+void CountCells(const NavGrid& grid, NavGridReport* r) {
+  r->width = grid.cells.cols;
+  r->height = grid.cells.rows;
+  for (uint8_t v : grid.cells) {
+    const NavCell c = static_cast<NavCell>(v);
+    (c == NavCell::kFree       ? r->num_free
+     : c == NavCell::kOccupied ? r->num_occupied
+                               : r->num_unknown)++;
+  }
+}
+
+// Marks floor samples free, then obstacle samples inside the band occupied.
+void Rasterize(const Map& map, const std::vector<PlaneRole>& roles,
+               const NavGridOptions& options, NavGrid* grid) {
+  auto mark = [&](const Eigen::Vector3d& x, NavCell value) {
+    const int c = static_cast<int>(
+        std::floor((x.x() - grid->origin.x()) / grid->resolution_m));
+    const int row = static_cast<int>(
+        std::floor((x.y() - grid->origin.y()) / grid->resolution_m));
+    if (c < 0 || row < 0 || c >= grid->cells.cols || row >= grid->cells.rows) {
+      return;
+    }
+    grid->cells(row, c) = static_cast<uint8_t>(value);
+  };
+  const double step = grid->resolution_m / kSamplesPerCell;
+  // Floor first, obstacles over it.
+  for (PlaneRole role : {PlaneRole::kFloor, PlaneRole::kObstacle}) {
+    for (size_t i = 0; i < map.planes.size(); ++i) {
+      if (roles[i] != role) continue;
+      SamplePlane(map.planes[i], step, [&](const Eigen::Vector3d& x) {
+        if (role == PlaneRole::kFloor) {
+          mark(x, NavCell::kFree);
+        } else if (x.z() >= options.min_z_m && x.z() <= options.max_z_m) {
+          mark(x, NavCell::kOccupied);
+        }
+      });
+    }
+  }
+}
+
 std::string Number(double v) {
   char buf[64];
   const auto r = std::to_chars(buf, buf + sizeof(buf), v);
@@ -97,20 +155,10 @@ NavGrid MakeNavGrid(const Map& map, const NavGridOptions& options,
                     NavGridReport* report) {
   options.Check();
   NavGridReport r;
-  std::vector<PlaneRole> roles;
-  Eigen::Vector2d lo = Eigen::Vector2d::Constant(INFINITY);
-  Eigen::Vector2d hi = -lo;
-  for (const TexturedPlane& p : map.planes) {
-    roles.push_back(Classify(p, options));
-    if (roles.back() == PlaneRole::kIgnored) continue;
-    (roles.back() == PlaneRole::kFloor ? r.num_floor_planes
-                                       : r.num_obstacle_planes)++;
-    for (const Eigen::Vector2d& st : p.polygon) {
-      const Eigen::Vector2d xy = p.frame.ToWorld(st).head<2>();
-      lo = lo.cwiseMin(xy);
-      hi = hi.cwiseMax(xy);
-    }
-  }
+  Eigen::AlignedBox2d extent;
+  const std::vector<PlaneRole> roles =
+      ClassifyPlanes(map, options, &extent, &r);
+  const Eigen::Vector2d lo = extent.min(), hi = extent.max();
   if (r.num_floor_planes + r.num_obstacle_planes == 0) {
     throw StageError(
         "navigation grid: no floor plane below z = " + Number(options.min_z_m) +
@@ -132,37 +180,8 @@ NavGrid MakeNavGrid(const Map& map, const NavGridOptions& options,
   }
   grid.cells = cv::Mat1b(std::max(rows, 1), std::max(cols, 1),
                          static_cast<uint8_t>(NavCell::kUnknown));
-  auto mark = [&](const Eigen::Vector3d& x, NavCell value) {
-    const int c = static_cast<int>(std::floor((x.x() - grid.origin.x()) / res));
-    const int row =
-        static_cast<int>(std::floor((x.y() - grid.origin.y()) / res));
-    if (c < 0 || row < 0 || c >= grid.cells.cols || row >= grid.cells.rows) {
-      return;
-    }
-    grid.cells(row, c) = static_cast<uint8_t>(value);
-  };
-  const double step = res / kSamplesPerCell;
-  // Floor first, obstacles over it.
-  for (PlaneRole role : {PlaneRole::kFloor, PlaneRole::kObstacle}) {
-    for (size_t i = 0; i < map.planes.size(); ++i) {
-      if (roles[i] != role) continue;
-      SamplePlane(map.planes[i], step, [&](const Eigen::Vector3d& x) {
-        if (role == PlaneRole::kFloor) {
-          mark(x, NavCell::kFree);
-        } else if (x.z() >= options.min_z_m && x.z() <= options.max_z_m) {
-          mark(x, NavCell::kOccupied);
-        }
-      });
-    }
-  }
-  r.width = grid.cells.cols;
-  r.height = grid.cells.rows;
-  for (uint8_t v : grid.cells) {
-    const NavCell c = static_cast<NavCell>(v);
-    (c == NavCell::kFree       ? r.num_free
-     : c == NavCell::kOccupied ? r.num_occupied
-                               : r.num_unknown)++;
-  }
+  Rasterize(map, roles, options, &grid);
+  CountCells(grid, &r);
   if (report) *report = r;
   return grid;
 }
