@@ -4,128 +4,15 @@
 
 #include <filesystem>
 
-#include "monomap/geometry/polygon.h"
 #include "monomap/io/nav_grid_export.h"
 #include "monomap/sim/world.h"
 #include "monomap/util/error.h"
+#include "nav_grid_truth.h"
 
 namespace monomap {
 namespace {
 
 namespace fs = std::filesystem;
-using Eigen::Vector2d;
-
-// The obstacles a grid should show, straight from the world's planes:
-// vertical rectangles reaching into the band as xy segments, horizontal
-// planes inside the band as xy polygons.
-struct Truth {
-  std::vector<std::pair<Vector2d, Vector2d>> segments;
-  std::vector<Polygon2d> areas;
-  Polygon2d floor;
-
-  double Distance(const Vector2d& p) const {
-    double d = INFINITY;
-    for (const auto& [a, b] : segments) {
-      const double t =
-          std::clamp((p - a).dot(b - a) / (b - a).squaredNorm(), 0.0, 1.0);
-      d = std::min(d, (a + t * (b - a) - p).norm());
-    }
-    for (const Polygon2d& area : areas)
-      d = std::min(d, DistanceToPolygon(area, p));
-    return d;
-  }
-};
-
-Truth TruthOf(const World& world, const NavGridOptions& o) {
-  Truth truth;
-  for (const TexturedPlane& p : world.planes) {
-    std::vector<Eigen::Vector3d> corners;
-    double z_lo = INFINITY, z_hi = -INFINITY;
-    for (const Vector2d& st : p.polygon) {
-      corners.push_back(p.frame.ToWorld(st));
-      z_lo = std::min(z_lo, corners.back().z());
-      z_hi = std::max(z_hi, corners.back().z());
-    }
-    Polygon2d xy;
-    for (const auto& c : corners) xy.push_back(c.head<2>());
-    if (&p == &world.planes[world.floor_plane]) {
-      truth.floor = xy;
-    } else if (z_hi < o.min_z_m || z_lo > o.max_z_m) {
-      continue;
-    } else if (std::abs(p.plane.normal.z()) < 0.1) {
-      // A vertical rectangle: its xy footprint is the segment between the
-      // two farthest corners.
-      std::pair<Vector2d, Vector2d> seg{xy[0], xy[0]};
-      for (const Vector2d& a : xy) {
-        for (const Vector2d& b : xy) {
-          if ((a - b).norm() > (seg.first - seg.second).norm()) seg = {a, b};
-        }
-      }
-      truth.segments.push_back(seg);
-    } else {
-      truth.areas.push_back(xy);
-    }
-  }
-  return truth;
-}
-
-struct Figures {
-  double max_wall_cell_distance_cells = 0;  // occupied cell centre to truth
-  double wall_length_covered = 0;           // fraction of true wall length
-  double free_outside_floor = 0;            // free cells off the floor
-  double interior_floor_free = 0;           // floor cells away from walls
-};
-
-Figures Measure(const NavGrid& grid, const Truth& truth) {
-  Figures f;
-  const double res = grid.resolution_m;
-  int free = 0, free_outside = 0, interior = 0, interior_free = 0;
-  for (int row = 0; row < grid.cells.rows; ++row) {
-    for (int c = 0; c < grid.cells.cols; ++c) {
-      const Vector2d x = grid.CellCenter(c, row);
-      const NavCell v = grid.At(c, row);
-      if (v == NavCell::kOccupied) {
-        f.max_wall_cell_distance_cells =
-            std::max(f.max_wall_cell_distance_cells, truth.Distance(x) / res);
-      }
-      if (v == NavCell::kFree) {
-        ++free;
-        if (DistanceToPolygon(truth.floor, x) > 0.5 * res) ++free_outside;
-      }
-      if (PointInPolygon(truth.floor, x) &&
-          DistanceToPolygon(truth.floor, x) == 0 && truth.Distance(x) > res) {
-        ++interior;
-        if (v == NavCell::kFree) ++interior_free;
-      }
-    }
-  }
-  f.free_outside_floor = free > 0 ? double(free_outside) / free : 1.0;
-  f.interior_floor_free = interior > 0 ? double(interior_free) / interior : 0.0;
-  // True wall length with an occupied cell within one cell.
-  int samples = 0, covered = 0;
-  for (const auto& [a, b] : truth.segments) {
-    const int n = static_cast<int>(std::ceil((b - a).norm() / (0.25 * res)));
-    for (int k = 0; k <= n; ++k) {
-      const Vector2d p = a + (b - a) * (double(k) / n);
-      const int c =
-          static_cast<int>(std::floor((p.x() - grid.origin.x()) / res));
-      const int row =
-          static_cast<int>(std::floor((p.y() - grid.origin.y()) / res));
-      bool hit = false;
-      for (int dr = -1; dr <= 1; ++dr) {
-        for (int dc = -1; dc <= 1; ++dc) {
-          const int cc = c + dc, rr = row + dr;
-          hit |= cc >= 0 && rr >= 0 && cc < grid.cells.cols &&
-                 rr < grid.cells.rows && grid.At(cc, rr) == NavCell::kOccupied;
-        }
-      }
-      ++samples;
-      covered += hit;
-    }
-  }
-  f.wall_length_covered = samples > 0 ? double(covered) / samples : 0.0;
-  return f;
-}
 
 TEST(NavGridTest, TrueWallsOfEveryWorldWithinOneCell) {
   for (const std::string& name : WorldNames()) {
@@ -148,7 +35,8 @@ TEST(NavGridTest, TrueWallsOfEveryWorldWithinOneCell) {
       EXPECT_EQ(report.num_floor_planes, 1);
       EXPECT_GT(report.num_occupied, 0);
 
-      const Figures f = Measure(grid, TruthOf(world, options));
+      const NavGridFigures f =
+          MeasureNavGrid(grid, NavGridTruth(world.planes, options));
       std::printf(
           "%-10s %.2f m: wall cells <= %.2f cells from truth, %.1f%% "
           "of wall length covered, %.1f%% of interior floor free, "
