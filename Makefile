@@ -5,10 +5,12 @@ BUILD_DIR ?= build
 JOBS ?= $(shell nproc)
 DEMO_DIR ?= out/demo
 
-# Debian 12 packages the build and the tests need.
+# Debian 12 packages the build and the tests need (colmap: the test that
+# reads the COLMAP export back; help2man: the man page).
 DEB_PACKAGES = cmake ninja-build g++ pkg-config libopencv-dev libeigen3-dev \
   libceres-dev libtbb-dev libyaml-cpp-dev nlohmann-json3-dev libcli11-dev \
-  libtinygltf-dev libstb-dev libgtest-dev libgmock-dev libbenchmark-dev
+  libtinygltf-dev libstb-dev libgtest-dev libgmock-dev libbenchmark-dev \
+  colmap help2man
 
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 

@@ -17,8 +17,10 @@
 #include <string>
 
 #include "monomap/geometry/polygon.h"
+#include "monomap/io/colmap_export.h"
 #include "monomap/io/feature_table.h"
 #include "monomap/io/map_format.h"
+#include "monomap/io/nav_grid_export.h"
 #include "monomap/io/trajectory_io.h"
 #include "monomap/sim/simulate.h"
 #include "tests/monomap_cli.h"
@@ -511,6 +513,76 @@ TEST_F(Cli, LocalizeTracksTheDatasetInItsMap) {
   EXPECT_EQ(r.exit_code, 1) << r.output;
   EXPECT_NE(r.output.find("odometry2d.txt"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(*root_ / "x.txt"));
+}
+
+// `export` on a built map: a COLMAP model named after the dataset's images
+// (read back by our reader, and by COLMAP when installed), a navigation
+// grid and a glb with extras; a bad height band writes nothing; --version
+// and an unknown subcommand.
+TEST_F(Cli, ExportWritesColmapNavGridAndGlb) {
+  const fs::path data = *root_ / "data";
+  const fs::path map_dir = *root_ / "map_export";
+  RunResult r =
+      RunMonomap("build " + data.string() + " -o " + map_dir.string() + " -q");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const fs::path out = *root_ / "export";
+  r = RunMonomap("export " + map_dir.string() + " --colmap " +
+                 (out / "colmap").string() + " --images " + data.string() +
+                 " --nav-grid " + (out / "nav").string() +
+                 " --resolution 0.1 --glb " + (out / "map.glb").string() +
+                 " --camera-path --points --y-up");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::printf("%s", r.output.c_str());
+  const Map map = ReadMap(map_dir);
+  const ColmapModel model = ReadColmapText(out / "colmap");
+  ASSERT_EQ(model.images.size(), map.trajectory.size());
+  ASSERT_EQ(model.points.size(), map.landmarks.size());
+  for (const auto& im : model.images) {
+    EXPECT_TRUE(fs::exists(data / im.name)) << im.name;
+  }
+  // Every landmark of a built map is triangulated from its track; the
+  // ERROR field is its reprojection error in the refined map.
+  double error_sum = 0;
+  size_t observations = 0;
+  for (const auto& p : model.points) {
+    EXPECT_GE(p.track.size(), 2u) << "point " << p.id;
+    error_sum += p.error * p.track.size();
+    observations += p.track.size();
+  }
+  const double mean_error_px = error_sum / observations;
+  std::printf("COLMAP export of the built map: mean reprojection error "
+              "%.3f px over %zu observations\n",
+              mean_error_px, observations);
+  EXPECT_LT(mean_error_px, 1.0);
+  if (std::system("command -v colmap > /dev/null 2>&1") == 0) {
+    const std::string cmd = "colmap model_analyzer --path " +
+                            (out / "colmap").string() + " > " +
+                            (out / "analyzer.log").string() + " 2>&1";
+    EXPECT_EQ(std::system(cmd.c_str()), 0);
+    std::ifstream log(out / "analyzer.log");
+    const std::string text((std::istreambuf_iterator<char>(log)), {});
+    EXPECT_NE(text.find("Points: " + std::to_string(model.points.size())),
+              std::string::npos)
+        << text;
+  }
+  const NavGrid grid = ReadNavGrid(out / "nav" / "map.yaml");
+  EXPECT_DOUBLE_EQ(grid.resolution_m, 0.1);
+  EXPECT_GT(cv::countNonZero(grid.cells == uint8_t(NavCell::kFree)), 100);
+  EXPECT_GT(fs::file_size(out / "map.glb"), 1000u);
+
+  r = RunMonomap("export " + map_dir.string() + " --nav-grid " +
+                 (out / "bad").string() + " --z-band 2 1");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("min_z_m"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(out / "bad"));
+  r = RunMonomap("exprot " + map_dir.string());
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("unknown subcommand 'exprot'"), std::string::npos)
+      << r.output;
+  r = RunMonomap("--version");
+  EXPECT_EQ(r.exit_code, 0);
+  EXPECT_EQ(r.output.rfind("monomap 0.", 0), 0u) << r.output;
+  EXPECT_NE(r.output.find("commit "), std::string::npos) << r.output;
 }
 
 }  // namespace

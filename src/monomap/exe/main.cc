@@ -8,11 +8,32 @@
 #include <cstdio>
 #include <exception>
 #include <memory>
+#include <string>
 
 #include "monomap/exe/commands.h"
 #include "monomap/exe/interrupt.h"
 #include "monomap/util/error.h"
 #include "monomap/util/runtime.h"
+#include "monomap/version.h"
+
+namespace {
+
+// CLI11 reports an unknown first word only as "A subcommand is required":
+// name it and list the subcommands instead. Returns false if it is unknown.
+bool CheckSubcommandName(CLI::App& app, int argc, char** argv) {
+  if (argc < 2 || argv[1][0] == '-') return true;
+  std::string names;
+  for (const CLI::App* sub :
+       app.get_subcommands([](CLI::App*) { return true; })) {
+    if (sub->get_name() == argv[1]) return true;
+    names += (names.empty() ? "" : ", ") + sub->get_name();
+  }
+  std::fprintf(stderr, "monomap: error: unknown subcommand '%s' (one of: %s)\n",
+               argv[1], names.c_str());
+  return false;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   // Before any thread exists: see exe/interrupt.h.
@@ -38,6 +59,9 @@ int main(int argc, char** argv) {
          "Worker threads (oneTBB); results do not depend on it "
          "(default: all cores)")
       ->check(CLI::Range(1, 1024));
+  app.set_version_flag("--version", std::string("monomap ") +
+                                        monomap::kVersion + " (commit " +
+                                        monomap::kGitCommit + ")");
   monomap::RegisterBuildCommand(app);
   monomap::RegisterEvalCommand(app);
   monomap::RegisterSimulateCommand(app);
@@ -45,6 +69,8 @@ int main(int argc, char** argv) {
   monomap::RegisterLocalizeCommand(app);
   monomap::RegisterCalibrateCommand(app);
   monomap::RegisterDemoCommand(app);
+  monomap::RegisterExportCommand(app);
+  if (!CheckSubcommandName(app, argc, argv)) return 2;
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

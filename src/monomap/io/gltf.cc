@@ -83,7 +83,8 @@ std::vector<Eigen::Vector3i> TriangulatePolygon(const Polygon2d& polygon) {
   return triangles;
 }
 
-void WriteMapGlb(const std::filesystem::path& path, const Map& map) {
+void WriteMapGlb(const std::filesystem::path& path, const Map& map,
+                 const GlbOptions& options) {
   tinygltf::Model model;
   model.asset.version = "2.0";
   model.asset.generator = "monomap";
@@ -122,8 +123,27 @@ void WriteMapGlb(const std::filesystem::path& path, const Map& map) {
   sampler.wrapT = TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
   model.samplers.push_back(sampler);
 
+  // World (z up) to the file's axes.
+  auto to_file = [&](const Eigen::Vector3d& x) -> Eigen::Vector3f {
+    return options.y_up ? Eigen::Vector3f(x.x(), x.z(), -x.y())
+                        : x.cast<float>();
+  };
+
   tinygltf::Scene scene;
   scene.name = "monomap";
+  // Adds a mesh of one primitive and a scene node showing it.
+  auto add_mesh_node = [&](const std::string& name,
+                           const tinygltf::Primitive& primitive) {
+    tinygltf::Mesh mesh;
+    mesh.name = name;
+    mesh.primitives.push_back(primitive);
+    model.meshes.push_back(mesh);
+    tinygltf::Node node;
+    node.name = name;
+    node.mesh = static_cast<int>(model.meshes.size()) - 1;
+    model.nodes.push_back(node);
+    scene.nodes.push_back(static_cast<int>(model.nodes.size()) - 1);
+  };
   for (const TexturedPlane& plane : map.planes) {
     if (plane.polygon.size() < 3 || plane.texture.empty() ||
         !(plane.pixels_per_meter > 0)) {
@@ -133,9 +153,9 @@ void WriteMapGlb(const std::filesystem::path& path, const Map& map) {
     const size_t n = plane.polygon.size();
     std::vector<float> positions, normals, texcoords;
     std::vector<double> min(3, INFINITY), max(3, -INFINITY);
-    const Eigen::Vector3f normal = plane.plane.normal.cast<float>();
+    const Eigen::Vector3f normal = to_file(plane.plane.normal);
     for (const Eigen::Vector2d& st : plane.polygon) {
-      const Eigen::Vector3f x = plane.frame.ToWorld(st).cast<float>();
+      const Eigen::Vector3f x = to_file(plane.frame.ToWorld(st));
       for (int k = 0; k < 3; ++k) {
         positions.push_back(x[k]);
         normals.push_back(normal[k]);
@@ -203,17 +223,60 @@ void WriteMapGlb(const std::filesystem::path& path, const Map& map) {
     model.materials.push_back(material);
     primitive.material = static_cast<int>(model.materials.size()) - 1;
 
-    tinygltf::Mesh mesh;
-    mesh.name = name;
-    mesh.primitives.push_back(primitive);
-    model.meshes.push_back(mesh);
-
-    tinygltf::Node node;
-    node.name = name;
-    node.mesh = static_cast<int>(model.meshes.size()) - 1;
-    model.nodes.push_back(node);
-    scene.nodes.push_back(static_cast<int>(model.nodes.size()) - 1);
+    add_mesh_node(name, primitive);
   }
+  // A mesh node of one untextured primitive (camera path, points).
+  auto add_node = [&](const std::string& name, int mode,
+                      const std::vector<Eigen::Vector3f>& xyz,
+                      const std::vector<Eigen::Vector3f>& rgb) {
+    if (xyz.empty()) return;
+    std::vector<double> min(3, INFINITY), max(3, -INFINITY);
+    for (const Eigen::Vector3f& x : xyz) {
+      for (int k = 0; k < 3; ++k) {
+        min[k] = std::min<double>(min[k], x[k]);
+        max[k] = std::max<double>(max[k], x[k]);
+      }
+    }
+    tinygltf::Primitive primitive;
+    primitive.mode = mode;
+    primitive.attributes["POSITION"] = add_accessor(
+        add_view(xyz.data(), xyz.size() * sizeof(Eigen::Vector3f),
+                 TINYGLTF_TARGET_ARRAY_BUFFER),
+        TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, xyz.size());
+    model.accessors.back().minValues = min;
+    model.accessors.back().maxValues = max;
+    if (!rgb.empty()) {
+      primitive.attributes["COLOR_0"] = add_accessor(
+          add_view(rgb.data(), rgb.size() * sizeof(Eigen::Vector3f),
+                   TINYGLTF_TARGET_ARRAY_BUFFER),
+          TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, rgb.size());
+    }
+    tinygltf::Material material;
+    material.name = name;
+    material.pbrMetallicRoughness.baseColorFactor =
+        rgb.empty() ? std::vector<double>{1.0, 0.2, 0.1, 1.0}
+                    : std::vector<double>{1.0, 1.0, 1.0, 1.0};
+    material.pbrMetallicRoughness.metallicFactor = 0.0;
+    model.materials.push_back(material);
+    primitive.material = static_cast<int>(model.materials.size()) - 1;
+    add_mesh_node(name, primitive);
+  };
+  if (options.camera_path) {
+    std::vector<Eigen::Vector3f> centres;
+    for (const TimedPose& p : map.trajectory) {
+      centres.push_back(to_file(p.world_from_cam.translation));
+    }
+    add_node("camera_path", TINYGLTF_MODE_LINE_STRIP, centres, {});
+  }
+  if (options.points) {
+    std::vector<Eigen::Vector3f> xyz, rgb;
+    for (const Landmark& l : map.landmarks) {
+      xyz.push_back(to_file(l.x_in_world));
+      rgb.push_back(l.color / 255.f);
+    }
+    add_node("landmarks", TINYGLTF_MODE_POINTS, xyz, rgb);
+  }
+
   if (bytes.empty()) {
     model.buffers.clear();
   } else {

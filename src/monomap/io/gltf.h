@@ -19,14 +19,26 @@ namespace monomap {
 // intersecting input) the rest is closed with a fan.
 std::vector<Eigen::Vector3i> TriangulatePolygon(const Polygon2d& polygon);
 
+// Optional content of map.glb beyond the textured planes.
+struct GlbOptions {
+  // A node "camera_path": the refined camera centres as a LINE_STRIP.
+  bool camera_path = false;
+  // A node "landmarks": the landmarks as POINTS with COLOR_0.
+  bool points = false;
+  // Convert the world (z up) to glTF's +Y up: (x, y, z) -> (x, z, -y), for
+  // viewers that assume glTF's convention.
+  bool y_up = false;
+};
+
 // Writes `map` as a .glb (atomically): per plane with >= 3 polygon vertices
 // and a texture, a node "plane_<id>" with a mesh whose vertices are the
 // polygon corners in world coordinates (float POSITION, NORMAL = plane
 // normal, TEXCOORD_0 = (s * ppm / width, t * ppm / height)), indices from
 // TriangulatePolygon, and a material with the texture PNG (embedded in the
 // binary buffer) as baseColorTexture, doubleSided, alphaMode MASK. Positions
-// stay in the map's world frame (no axis conversion to glTF's +Y up).
-// Throws OutputError on failure.
-void WriteMapGlb(const std::filesystem::path& path, const Map& map);
+// stay in the map's world frame unless options.y_up; options add the camera
+// path and the landmarks. Throws OutputError on failure.
+void WriteMapGlb(const std::filesystem::path& path, const Map& map,
+                 const GlbOptions& options = GlbOptions());
 
 }  // namespace monomap

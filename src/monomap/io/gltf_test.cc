@@ -156,6 +156,125 @@ TEST(GltfTest, GlbRoundTripsThroughTinyGltf) {
   }
 }
 
+// The node of this name, or nullptr.
+const tinygltf::Node* FindNode(const tinygltf::Model& model,
+                               const std::string& name) {
+  for (const tinygltf::Node& n : model.nodes) {
+    if (n.name == name) return &n;
+  }
+  return nullptr;
+}
+
+TEST(GltfTest, CameraPathPointsAndYUp) {
+  Map map;
+  TexturedPlane wall;
+  wall.id = 0;
+  wall.plane.normal = Eigen::Vector3d::UnitY();
+  wall.plane.offset = -2.0;  // y = 2
+  wall.frame = MakePlaneFrame(wall.plane, {0, 2, 0}, {1, 0, 0});
+  wall.pixels_per_meter = 10;
+  wall.texture = cv::Mat(10, 10, CV_8UC4, cv::Scalar(1, 2, 3, 255));
+  wall.polygon = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+  map.planes.push_back(wall);
+  for (int i = 0; i < 5; ++i) {
+    map.trajectory.push_back(
+        {0.1 * i, Rigid3d(Eigen::Quaterniond::Identity(),
+                          Eigen::Vector3d(0.5 * i, -0.1 * i, 0.3))});
+  }
+  for (int i = 0; i < 7; ++i) {
+    Landmark l;
+    l.id = i;
+    l.x_in_world = {0.1 * i, 2.0, 1.0 + 0.05 * i};
+    l.color = {255.f, 51.f * (i % 5), 0.f};
+    map.landmarks.push_back(l);
+  }
+  for (bool y_up : {false, true}) {
+    SCOPED_TRACE(y_up ? "y up" : "z up");
+    const fs::path path = fs::temp_directory_path() / "monomap_gltf_extras.glb";
+    WriteMapGlb(path, map, {.camera_path = true, .points = true, .y_up = y_up});
+    tinygltf::TinyGLTF loader;
+    tinygltf::Model model;
+    std::string error, warning;
+    ASSERT_TRUE(
+        loader.LoadBinaryFromFile(&model, &error, &warning, path.string()))
+        << error;
+    EXPECT_EQ(model.scenes.at(0).nodes.size(), 3u);
+    // World (x, y, z) is stored as (x, z, -y) in the Y-up file.
+    auto stored = [&](const Eigen::Vector3d& x) -> Eigen::Vector3d {
+      return y_up ? Eigen::Vector3d(x.x(), x.z(), -x.y()) : x;
+    };
+
+    const tinygltf::Node* path_node = FindNode(model, "camera_path");
+    ASSERT_NE(path_node, nullptr);
+    const tinygltf::Primitive& line =
+        model.meshes.at(path_node->mesh).primitives.at(0);
+    EXPECT_EQ(line.mode, TINYGLTF_MODE_LINE_STRIP);
+    const auto centres =
+        AccessorValues<float>(model, line.attributes.at("POSITION"), 3);
+    ASSERT_EQ(centres.size(), 3 * map.trajectory.size());
+    double max_error = 0;
+    for (size_t i = 0; i < map.trajectory.size(); ++i) {
+      const Eigen::Vector3d expected =
+          stored(map.trajectory[i].world_from_cam.translation);
+      max_error = std::max(max_error,
+                           (Eigen::Vector3d(centres[3 * i], centres[3 * i + 1],
+                                            centres[3 * i + 2]) -
+                            expected)
+                               .norm());
+    }
+    EXPECT_LT(max_error, 1e-6);
+
+    const tinygltf::Node* points_node = FindNode(model, "landmarks");
+    ASSERT_NE(points_node, nullptr);
+    const tinygltf::Primitive& points =
+        model.meshes.at(points_node->mesh).primitives.at(0);
+    EXPECT_EQ(points.mode, TINYGLTF_MODE_POINTS);
+    const auto xyz =
+        AccessorValues<float>(model, points.attributes.at("POSITION"), 3);
+    const auto rgb =
+        AccessorValues<float>(model, points.attributes.at("COLOR_0"), 3);
+    ASSERT_EQ(xyz.size(), 3 * map.landmarks.size());
+    ASSERT_EQ(rgb.size(), 3 * map.landmarks.size());
+    max_error = 0;
+    double max_color_error = 0;
+    for (size_t i = 0; i < map.landmarks.size(); ++i) {
+      const Eigen::Vector3d expected = stored(map.landmarks[i].x_in_world);
+      max_error = std::max(
+          max_error,
+          (Eigen::Vector3d(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]) -
+           expected)
+              .norm());
+      max_color_error = std::max<double>(
+          max_color_error,
+          (Eigen::Vector3f(rgb[3 * i], rgb[3 * i + 1], rgb[3 * i + 2]) -
+           map.landmarks[i].color / 255.f)
+              .norm());
+    }
+    EXPECT_LT(max_error, 1e-6);
+    EXPECT_LT(max_color_error, 1e-6);
+
+    // The wall's corners and normal in the file's axes.
+    const tinygltf::Primitive& quad =
+        model.meshes.at(FindNode(model, "plane_0")->mesh).primitives.at(0);
+    const auto corners =
+        AccessorValues<float>(model, quad.attributes.at("POSITION"), 3);
+    const auto normals =
+        AccessorValues<float>(model, quad.attributes.at("NORMAL"), 3);
+    ASSERT_EQ(corners.size(), 12u);
+    max_error = 0;
+    for (size_t k = 0; k < 4; ++k) {
+      const Eigen::Vector3d c(corners[3 * k], corners[3 * k + 1],
+                              corners[3 * k + 2]);
+      const Eigen::Vector3d n(normals[3 * k], normals[3 * k + 1],
+                              normals[3 * k + 2]);
+      max_error = std::max(
+          {max_error, (c - stored(wall.frame.ToWorld(wall.polygon[k]))).norm(),
+           (n - stored(Eigen::Vector3d::UnitY())).norm()});
+    }
+    EXPECT_LT(max_error, 1e-6);
+  }
+}
+
 TEST(GltfTest, EmptyMapIsAValidGlb) {
   const fs::path path = fs::temp_directory_path() / "monomap_gltf_empty.glb";
   WriteMapGlb(path, Map());
