@@ -1,0 +1,75 @@
+// Imports a TUM RGB-D sequence as distributed (rgb.txt with its comment
+// header, rgb/*.png, groundtruth.txt; no calibration, no odometry) into
+// monomap's dataset layout (docs/importing.md). The intrinsics come from
+// the user or a named preset; the odometry from a file or, honestly
+// labelled, simulated from the ground truth with chosen errors.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "monomap/camera/camera.h"
+
+namespace monomap {
+
+// Errors of odometry simulated from ground truth: each step between two
+// frames (in the previous camera frame) is scaled and perturbed, so the
+// odometry drifts like wheel or visual odometry would.
+struct OdometryFromGroundTruthOptions {
+  // Systematic scale error of every step's translation (0.02: 2% too long).
+  double scale_error = 0.02;
+  // Random translation error per step, standard deviation as a fraction of
+  // the step's length (per axis).
+  double translation_noise = 0.01;
+  // Random rotation error, standard deviation in degrees per metre moved
+  // (per axis).
+  double rotation_noise_deg_per_m = 1.0;
+  // Seed of the random errors.
+  uint64_t seed = 1;
+
+  void Check() const;
+};
+
+struct TumImportOptions {
+  // Named TUM calibration ("fr1", "fr2", "fr3"); empty: use `intrinsics`.
+  std::string preset;
+  // fx, fy, cx, cy[, k1, k2, p1, p2[, k3]] (pixels; plumb_bob) when no
+  // preset is given.
+  std::vector<double> intrinsics;
+  // A TUM trajectory file of odometry (world_from_cam); empty: simulate
+  // odometry from groundtruth.txt with `simulated`.
+  std::filesystem::path odometry;
+  OdometryFromGroundTruthOptions simulated;
+  // Largest gap (s) between the two trajectory samples around an image;
+  // images in larger gaps or outside the trajectory are dropped (counted).
+  double max_pose_gap = 0.1;
+
+  void Check() const;
+};
+
+struct TumImportReport {
+  int images_listed = 0;
+  int frames_written = 0;
+  // Images with no pose (outside the trajectory or in a gap).
+  int dropped = 0;
+  bool odometry_simulated = false;
+  // Of the written odometry against ground truth (when it has both).
+  double path_length_m = 0.0;
+  double final_drift_m = 0.0;
+  Camera camera;
+};
+
+// The published calibration of the TUM RGB-D benchmark's cameras (fr1,
+// fr2, fr3; 640x480). Throws OptionsError for another name.
+Camera TumPresetCamera(const std::string& name);
+
+// Reads the sequence in `tum_dir` and writes the dataset to `out_dir`
+// atomically. Images are hard-linked when possible, copied otherwise.
+// Throws InputError naming file and line or field; nothing is written then.
+TumImportReport ImportTum(const std::filesystem::path& tum_dir,
+                          const std::filesystem::path& out_dir,
+                          const TumImportOptions& options);
+
+}  // namespace monomap

@@ -1,0 +1,157 @@
+#include "monomap/io/tum_import.h"
+
+#include <gtest/gtest.h>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "monomap/io/dataset.h"
+#include "monomap/io/trajectory_io.h"
+#include "monomap/util/error.h"
+#include "monomap/util/file.h"
+
+namespace monomap {
+namespace {
+namespace fs = std::filesystem;
+
+const fs::path kDir = fs::temp_directory_path() / "monomap_tum_import_test";
+
+// A hand-held camera path: moving forward and sideways, turning slowly.
+Rigid3d TruePose(double t) {
+  const double s = t - 1000.0;
+  return Rigid3d(YawRotation(0.2 * s) *
+                     Eigen::Quaterniond(Eigen::AngleAxisd(
+                         0.05 * std::sin(s), Eigen::Vector3d::UnitX())),
+                 Eigen::Vector3d(0.3 * s, 0.1 * std::sin(2 * s), 1.5));
+}
+
+// A TUM sequence as distributed: ground truth at 100 Hz over [1000, 1004]
+// s, images at 30 Hz from 999.8 s (the first 6 before the ground truth).
+fs::path WriteTumSequence(int width, bool with_groundtruth) {
+  const fs::path dir = kDir / "rgbd_dataset_freiburg1_test";
+  fs::remove_all(dir);
+  fs::create_directories(dir / "rgb");
+  std::string rgb = "# color images\n# file: 'rgbd_dataset_freiburg1_test.bag'"
+                    "\n# timestamp filename\n";
+  for (int k = 0; k < 60; ++k) {
+    char stamp[64];
+    std::snprintf(stamp, sizeof(stamp), "%.6f", 999.8 + k / 30.0);
+    const std::string name = "rgb/" + std::string(stamp) + ".png";
+    cv::Mat image(width * 3 / 4, width, CV_8UC3, cv::Scalar(k, 2 * k, 100));
+    cv::imwrite((dir / name).string(), image);
+    rgb += std::string(stamp) + " " + name + "\n";
+  }
+  WriteFileAtomic(dir / "rgb.txt", rgb);
+  if (with_groundtruth) {
+    std::vector<TimedPose> gt;
+    for (int i = 0; i <= 400; ++i) {
+      gt.push_back({1000.0 + i / 100.0, TruePose(1000.0 + i / 100.0)});
+    }
+    WriteTumTrajectory(dir / "groundtruth.txt", gt, "ground truth trajectory");
+  }
+  return dir;
+}
+
+TumImportOptions ExactOdometry() {
+  TumImportOptions o;
+  o.preset = "fr1";
+  o.simulated.scale_error = 0;
+  o.simulated.translation_noise = 0;
+  o.simulated.rotation_noise_deg_per_m = 0;
+  return o;
+}
+
+TEST(TumImport, PresetAndExactOdometryGiveTheGroundTruth) {
+  const fs::path tum = WriteTumSequence(640, true);
+  const TumImportReport r = ImportTum(tum, kDir / "out", ExactOdometry());
+  EXPECT_EQ(r.images_listed, 60);
+  EXPECT_EQ(r.dropped, 6);  // 999.8 .. 999.9667 s, before the ground truth
+  EXPECT_EQ(r.frames_written, 54);
+  EXPECT_TRUE(r.odometry_simulated);
+  EXPECT_LT(r.final_drift_m, 1e-9);
+  const Dataset ds = LoadDataset(kDir / "out");
+  ASSERT_EQ(ds.frames.size(), 54u);
+  EXPECT_TRUE(ds.has_groundtruth);
+  EXPECT_DOUBLE_EQ(ds.camera.fx, 517.306408);
+  EXPECT_DOUBLE_EQ(ds.camera.distortion[4], 1.163314);
+  EXPECT_EQ(ReadFileToString(kDir / "out" / "groundtruth.txt"),
+            ReadFileToString(tum / "groundtruth.txt"));
+  double worst = 0;
+  for (const DatasetFrame& f : ds.frames) {
+    ASSERT_TRUE(f.groundtruth_world_from_cam.has_value());
+    const Rigid3d& a = f.odometry_world_from_cam;
+    const Rigid3d& b = *f.groundtruth_world_from_cam;
+    worst = std::max(worst, (a.translation - b.translation).norm() +
+                                AngleBetween(a.rotation, b.rotation));
+  }
+  EXPECT_LT(worst, 1e-6);
+}
+
+TEST(TumImport, SimulatedOdometryHasTheChosenScaleAndSeededDrift) {
+  const fs::path tum = WriteTumSequence(640, true);
+  TumImportOptions o = ExactOdometry();
+  o.simulated.scale_error = 0.05;
+  ImportTum(tum, kDir / "scaled", o);
+  const Dataset ds = LoadDataset(kDir / "scaled");
+  double odo_length = 0, gt_length = 0;
+  for (size_t i = 1; i < ds.frames.size(); ++i) {
+    odo_length += (ds.frames[i].odometry_world_from_cam.translation -
+                   ds.frames[i - 1].odometry_world_from_cam.translation)
+                      .norm();
+    gt_length += (ds.frames[i].groundtruth_world_from_cam->translation -
+                  ds.frames[i - 1].groundtruth_world_from_cam->translation)
+                     .norm();
+  }
+  // Without rotation noise, each step is the true step scaled by 1.05.
+  EXPECT_NEAR(odo_length / gt_length, 1.05, 1e-6);
+  EXPECT_GT(gt_length, 0.5);
+
+  o = TumImportOptions();
+  o.preset = "fr1";
+  o.simulated.seed = 7;
+  const double drift_a = ImportTum(tum, kDir / "a", o).final_drift_m;
+  const double drift_b = ImportTum(tum, kDir / "b", o).final_drift_m;
+  o.simulated.seed = 8;
+  const double drift_c = ImportTum(tum, kDir / "c", o).final_drift_m;
+  EXPECT_EQ(drift_a, drift_b);
+  EXPECT_EQ(ReadFileToString(kDir / "a" / "odometry.txt"),
+            ReadFileToString(kDir / "b" / "odometry.txt"));
+  EXPECT_NE(drift_a, drift_c);
+  EXPECT_GT(drift_a, 0.005);  // 2% scale error alone over ~0.6 m
+}
+
+std::string ImportError(const fs::path& tum, const TumImportOptions& o) {
+  try {
+    ImportTum(tum, kDir / "failed", o);
+  } catch (const Error& e) {
+    EXPECT_FALSE(fs::exists(kDir / "failed"));
+    return e.what();
+  }
+  return "";
+}
+
+TEST(TumImport, ErrorsNameTheFileOrOption) {
+  fs::path tum = WriteTumSequence(320, true);
+  std::string e = ImportError(tum, ExactOdometry());
+  EXPECT_NE(e.find("999.800000.png: image is 320x240 but preset fr1 is for "
+                   "640x480"),
+            std::string::npos)
+      << e;
+  TumImportOptions o = ExactOdometry();
+  o.preset.clear();
+  o.intrinsics = {260, 260, 159.5, 119.5};
+  EXPECT_EQ(ImportTum(tum, kDir / "own", o).camera.width, 320);
+  o.intrinsics = {260, 260, 159.5};
+  e = ImportError(tum, o);
+  EXPECT_NE(e.find("tum.intrinsics: expected fx,fy,cx,cy"), std::string::npos)
+      << e;
+  o.preset = "fr4";
+  o.intrinsics.clear();
+  e = ImportError(tum, o);
+  EXPECT_NE(e.find("'fr4' is not a TUM camera"), std::string::npos) << e;
+  tum = WriteTumSequence(640, false);
+  e = ImportError(tum, ExactOdometry());
+  EXPECT_NE(e.find("groundtruth.txt: not found"), std::string::npos) << e;
+}
+
+}  // namespace
+}  // namespace monomap
