@@ -21,8 +21,8 @@ namespace {
 namespace fs = std::filesystem;
 using namespace rosbag_test;
 
-const fs::path kRoot =
-    fs::temp_directory_path() / ("monomap_import_e2e_" + std::to_string(getpid()));
+const fs::path kRoot = fs::temp_directory_path() /
+                       ("monomap_import_e2e_" + std::to_string(getpid()));
 
 double PoseError(const Rigid3d& a, const Rigid3d& b) {
   return (a.translation - b.translation).norm() +
@@ -44,9 +44,9 @@ fs::path WriteBagOf(const Dataset& sim) {
     const Pose2d& b = *f.odometry_base;
     const Rigid3d odom_from_base(YawRotation(b.yaw),
                                  Eigen::Vector3d(b.x, b.y, 0.0));
-    bag.write("/odom", ros::Time(f.timestamp),
-              OdometryMsg(odom_from_base, "odom", "base_footprint",
-                          f.timestamp));
+    bag.write(
+        "/odom", ros::Time(f.timestamp),
+        OdometryMsg(odom_from_base, "odom", "base_footprint", f.timestamp));
     const cv::Mat image = sim.LoadImage(i, /*color=*/true);
     bag.write("/camera/image_raw", ros::Time(f.timestamp),
               ImageMsg(image, "bgr8", "camera_optical", f.timestamp));
@@ -93,11 +93,11 @@ TEST(ImportE2e, SimulatedHallwayRoundTripsThroughARosbag) {
     max_pose = std::max(max_pose, PoseError(a.odometry_world_from_cam,
                                             b.odometry_world_from_cam));
     max_base = std::max(
-        max_base, std::abs(a.odometry_base->x - b.odometry_base->x) +
-                      std::abs(a.odometry_base->y - b.odometry_base->y) +
-                      std::abs(std::remainder(
-                          a.odometry_base->yaw - b.odometry_base->yaw,
-                          2 * M_PI)));
+        max_base,
+        std::abs(a.odometry_base->x - b.odometry_base->x) +
+            std::abs(a.odometry_base->y - b.odometry_base->y) +
+            std::abs(std::remainder(a.odometry_base->yaw - b.odometry_base->yaw,
+                                    2 * M_PI)));
     cv::Mat diff;
     cv::absdiff(sim.LoadImage(i, true), imported.LoadImage(i, true), diff);
     double worst = 0;

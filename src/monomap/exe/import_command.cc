@@ -36,10 +36,11 @@ void RegisterRosbagImport(CLI::App* import) {
   cmd->add_option("--camera-info-topic", o->camera_info_topic,
                   "sensor_msgs/CameraInfo topic")
       ->required();
-  auto* odom = cmd->add_option("--odom-topic", o->odom_topic,
-                               "nav_msgs/Odometry topic");
-  auto* odom_tf = cmd->add_option(
-      "--odom-tf", o->odom_tf, "Odometry as tf PARENT:CHILD, e.g. odom:base_link");
+  auto* odom =
+      cmd->add_option("--odom-topic", o->odom_topic, "nav_msgs/Odometry topic");
+  auto* odom_tf =
+      cmd->add_option("--odom-tf", o->odom_tf,
+                      "Odometry as tf PARENT:CHILD, e.g. odom:base_link");
   odom->excludes(odom_tf);
   cmd->add_option("--tf-topic", o->tf_topic, "Topic of dynamic transforms")
       ->capture_default_str();
@@ -133,8 +134,8 @@ void RegisterTumImport(CLI::App* import) {
                  r.odometry_simulated ? "SIMULATED from ground truth"
                                       : "from the given file");
     if (r.odometry_simulated) {
-      std::fprintf(stderr, " (final drift %.3f m over %.2f m)",
-                   r.final_drift_m, r.path_length_m);
+      std::fprintf(stderr, " (final drift %.3f m over %.2f m)", r.final_drift_m,
+                   r.path_length_m);
     }
     std::fprintf(stderr, " -> %s\n", out->c_str());
   });

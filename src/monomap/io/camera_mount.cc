@@ -36,9 +36,9 @@ double Scalar(const fs::path& path, const YAML::Node& node,
 std::vector<double> Numbers(const fs::path& path, const YAML::Node& node,
                             const std::string& field, size_t count) {
   if (!node || !node.IsSequence() || node.size() != count) {
-    throw InputError(path.string(), field,
-                     "expected a list of " + std::to_string(count) +
-                         " numbers");
+    throw InputError(
+        path.string(), field,
+        "expected a list of " + std::to_string(count) + " numbers");
   }
   std::vector<double> values;
   for (const YAML::Node& v : node) values.push_back(Scalar(path, v, field));
@@ -109,8 +109,8 @@ Eigen::Quaterniond QuaternionField(const fs::path& path, const YAML::Node& m,
 
 Rigid3d FromTranslationQuaternion(const fs::path& path, const YAML::Node& m,
                                   const std::string& prefix) {
-  static const std::set<std::string> kKnown = {
-      "translation", "rotation_xyzw", "rotation_wxyz", "rotation"};
+  static const std::set<std::string> kKnown = {"translation", "rotation_xyzw",
+                                               "rotation_wxyz", "rotation"};
   for (const auto& kv : m) {
     const std::string key = kv.first.as<std::string>("");
     if (!kKnown.count(key)) {

@@ -8,10 +8,10 @@
 //   any of these keys holding an OpenCV matrix {rows: 4, cols: 4, data: [..]}
 #pragma once
 
+#include <yaml-cpp/yaml.h>
+
 #include <filesystem>
 #include <string>
-
-#include <yaml-cpp/yaml.h>
 
 #include "monomap/geometry/rigid3.h"
 

@@ -59,8 +59,7 @@ TEST(CameraMountTest, AllFormsGiveTheSameMount) {
        << q.y() << ", " << q.z() << "]\n";
   map_form << "base_from_cam:\n  translation: [" << t.x() << ", " << t.y()
            << ", " << t.z() << "]\n  rotation: {x: " << q.x()
-           << ", y: " << q.y() << ", z: " << q.z() << ", w: " << q.w()
-           << "}\n";
+           << ", y: " << q.y() << ", z: " << q.z() << ", w: " << q.w() << "}\n";
   const std::vector<std::string> forms = {
       xyzw.str(),
       wxyz.str(),
@@ -69,7 +68,8 @@ TEST(CameraMountTest, AllFormsGiveTheSameMount) {
       "T_base_cam: " + MatrixList(m) + "\n",
       "T_cam_base: " + MatrixList(m.Inverse()) + "\n",
       "%YAML:1.0\n---\nT_base_cam: !!opencv-matrix\n  rows: 4\n  cols: 4\n"
-      "  dt: d\n  data: " + MatrixList(m) + "\n",
+      "  dt: d\n  data: " +
+          MatrixList(m) + "\n",
   };
   for (const std::string& yaml : forms) {
     SCOPED_TRACE(yaml);
@@ -88,8 +88,8 @@ TEST(CameraMountTest, BadFormsNameTheField) {
   }
   scaled_list << "]";
 
-  EXPECT_NE(ErrorOf("T_base_cam: " + scaled_list.str()).find(
-                "mount.yaml: field 'T_base_cam': rotation part is not"),
+  EXPECT_NE(ErrorOf("T_base_cam: " + scaled_list.str())
+                .find("mount.yaml: field 'T_base_cam': rotation part is not"),
             std::string::npos)
       << ErrorOf("T_base_cam: " + scaled_list.str());
   EXPECT_NE(ErrorOf("T_base_cam: [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, "

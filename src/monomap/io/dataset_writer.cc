@@ -47,7 +47,8 @@ std::string Odometry2dList(const std::vector<ImportedFrame>& frames,
 
 std::optional<Pose2d> PlanarPose(const Rigid3d& world_from_base,
                                  double max_tilt_rad, double max_height_m) {
-  const Eigen::Vector3d up = world_from_base.rotation * Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d up =
+      world_from_base.rotation * Eigen::Vector3d::UnitZ();
   if (std::acos(std::clamp(up.z(), -1.0, 1.0)) > max_tilt_rad) {
     return std::nullopt;
   }

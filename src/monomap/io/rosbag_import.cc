@@ -32,10 +32,10 @@ void RosbagImportOptions::Check() const {
               "must be set");
   CheckOption(odom_topic.empty() != odom_tf.empty(), "rosbag.odom_topic",
               "set exactly one of odom_topic and odom_tf");
-  CheckOption(odom_tf.empty() || (odom_tf.find(':') != std::string::npos &&
-                                  odom_tf.front() != ':' &&
-                                  odom_tf.back() != ':'),
-              "rosbag.odom_tf", "must be PARENT:CHILD, e.g. odom:base_link");
+  CheckOption(
+      odom_tf.empty() || (odom_tf.find(':') != std::string::npos &&
+                          odom_tf.front() != ':' && odom_tf.back() != ':'),
+      "rosbag.odom_tf", "must be PARENT:CHILD, e.g. odom:base_link");
   CheckOption(max_odometry_gap > 0, "rosbag.max_odometry_gap", "must be > 0");
   CheckOption(max_planar_tilt_deg >= 0, "rosbag.max_planar_tilt_deg",
               "must be >= 0");
@@ -57,10 +57,10 @@ std::string Frame(const std::string& name) {
 }
 
 Rigid3d FromTransform(const geometry_msgs::Transform& t) {
-  return Rigid3d(Eigen::Quaterniond(t.rotation.w, t.rotation.x, t.rotation.y,
-                                    t.rotation.z),
-                 Eigen::Vector3d(t.translation.x, t.translation.y,
-                                 t.translation.z));
+  return Rigid3d(
+      Eigen::Quaterniond(t.rotation.w, t.rotation.x, t.rotation.y,
+                         t.rotation.z),
+      Eigen::Vector3d(t.translation.x, t.translation.y, t.translation.z));
 }
 
 Rigid3d FromPose(const geometry_msgs::Pose& p) {
@@ -90,7 +90,8 @@ class BagTopics {
     }
     if (std::find(types.begin(), types.end(), it->second) == types.end()) {
       std::string expected;
-      for (const auto& t : types) expected += (expected.empty() ? "" : " or ") + t;
+      for (const auto& t : types)
+        expected += (expected.empty() ? "" : " or ") + t;
       throw InputError(bag_name_ + ": topic '" + topic + "' holds " +
                        it->second + ", expected " + expected);
     }
@@ -131,8 +132,8 @@ Camera CameraFromInfo(const sensor_msgs::CameraInfo& info,
   c.fy = info.K[4];
   c.cy = info.K[5];
   const std::string& model = info.distortion_model;
-  const bool no_distortion =
-      std::all_of(info.D.begin(), info.D.end(), [](double d) { return d == 0; });
+  const bool no_distortion = std::all_of(info.D.begin(), info.D.end(),
+                                         [](double d) { return d == 0; });
   if (model == "plumb_bob" || (model.empty() && no_distortion)) {
     if (info.D.size() > 5 || (!info.D.empty() && info.D.size() < 4)) {
       throw InputError(where, "D",
@@ -209,12 +210,12 @@ Odometry ReadOdometry(const rosbag::Bag& bag, const BagTopics& topics,
                           }),
               poses.end());
   if (poses.size() < 2) {
-    throw InputError(name + ": " +
-                     (o.odom_topic.empty()
-                          ? "topic '" + o.tf_topic + "': no transform " +
-                                o.odom_tf + " (fewer than 2)"
-                          : "topic '" + o.odom_topic +
-                                "': fewer than 2 odometry messages"));
+    throw InputError(
+        name + ": " +
+        (o.odom_topic.empty()
+             ? "topic '" + o.tf_topic + "': no transform " + o.odom_tf +
+                   " (fewer than 2)"
+             : "topic '" + o.odom_topic + "': fewer than 2 odometry messages"));
   }
   return odo;
 }
@@ -254,12 +255,13 @@ std::optional<Rigid3d> MountFromTfStatic(const rosbag::Bag& bag,
 // An image message decoded: the pixels (for checks) and the file to write.
 struct DecodedImage {
   cv::Mat pixels;
-  std::string extension;        // ".png" or ".jpg"
-  std::vector<uchar> encoded;   // file contents
+  std::string extension;       // ".png" or ".jpg"
+  std::vector<uchar> encoded;  // file contents
   std::string encoding;
 };
 
-DecodedImage DecodeRaw(const sensor_msgs::Image& msg, const std::string& where) {
+DecodedImage DecodeRaw(const sensor_msgs::Image& msg,
+                       const std::string& where) {
   int type = 0;
   if (msg.encoding == "mono8") {
     type = CV_8UC1;
@@ -301,14 +303,14 @@ DecodedImage DecodeCompressed(const sensor_msgs::CompressedImage& msg,
   d.encoding = "compressed " + msg.format;
   d.pixels = cv::imdecode(msg.data, cv::IMREAD_UNCHANGED);
   if (d.pixels.empty()) {
-    throw InputError(where, "data",
-                     "cannot decode the compressed image (format '" +
-                         msg.format + "')");
+    throw InputError(
+        where, "data",
+        "cannot decode the compressed image (format '" + msg.format + "')");
   }
   const bool png = msg.data.size() > 4 && msg.data[0] == 0x89 &&
                    msg.data[1] == 'P' && msg.data[2] == 'N';
-  const bool jpeg = msg.data.size() > 2 && msg.data[0] == 0xFF &&
-                    msg.data[1] == 0xD8;
+  const bool jpeg =
+      msg.data.size() > 2 && msg.data[0] == 0xFF && msg.data[1] == 0xD8;
   if (png || jpeg) {
     d.extension = png ? ".png" : ".jpg";
     d.encoded.assign(msg.data.begin(), msg.data.end());
@@ -325,7 +327,7 @@ void WriteBytes(const fs::path& path, const std::vector<uchar>& bytes) {
 
 struct ImportState {
   const RosbagImportOptions& options;
-  std::string name;           // the bag's path for messages
+  std::string name;  // the bag's path for messages
   Camera camera;
   Odometry odometry;
   Rigid3d base_from_cam;
@@ -431,10 +433,11 @@ void ResolveMount(const rosbag::Bag& bag, const BagTopics& topics,
                      "--camera-frame)");
   }
   s.base_from_cam = *mount;
-  s.report.mount_source = base == camera ? "identity (odometry of the camera "
-                                           "frame '" + camera + "')"
-                                         : o.tf_static_topic + " " + base +
-                                               " -> " + camera;
+  s.report.mount_source =
+      base == camera ? "identity (odometry of the camera "
+                       "frame '" +
+                           camera + "')"
+                     : o.tf_static_topic + " " + base + " -> " + camera;
 }
 
 void ImportFromOpenBag(const rosbag::Bag& bag, ImportState& s) {
@@ -471,7 +474,8 @@ RosbagImportReport ImportRosbag(const fs::path& bag_path,
     bag.open(bag_path.string(), rosbag::bagmode::Read);
     ImportFromOpenBag(bag, s);
   } catch (const rosbag::BagException& e) {
-    throw InputError(s.name + ": cannot read the bag (truncated, unindexed "
+    throw InputError(s.name +
+                     ": cannot read the bag (truncated, unindexed "
                      "or not a ROS 1 bag; `rosbag reindex` may repair it): " +
                      e.what());
   } catch (const ros::Exception& e) {
@@ -480,10 +484,10 @@ RosbagImportReport ImportRosbag(const fs::path& bag_path,
   const bool planar = std::all_of(
       s.frames.begin(), s.frames.end(),
       [](const ImportedFrame& f) { return f.odometry_base.has_value(); });
-  WriteImportedDataset(out.path(), s.camera, s.frames,
-                       planar ? std::optional<Rigid3d>(s.base_from_cam)
-                              : std::nullopt,
-                       bag_path.string());
+  WriteImportedDataset(
+      out.path(), s.camera, s.frames,
+      planar ? std::optional<Rigid3d>(s.base_from_cam) : std::nullopt,
+      bag_path.string());
   out.Commit();
   RosbagImportReport& r = s.report;
   r.frames_written = static_cast<int>(s.frames.size());

@@ -32,8 +32,8 @@ Camera TestCamera() {
 // The base drives along a curve: x linear, y quadratic, yaw linear in time.
 Rigid3d BaseAt(double t) {
   const double s = t - 100.0;
-  return Rigid3d(YawRotation(0.4 * s), Eigen::Vector3d(1.0 + 0.8 * s,
-                                                        0.3 * s * s, 0.0));
+  return Rigid3d(YawRotation(0.4 * s),
+                 Eigen::Vector3d(1.0 + 0.8 * s, 0.3 * s * s, 0.0));
 }
 
 // base_link -> camera_link -> camera_optical: 0.2 m forward, 0.5 m up,
@@ -97,9 +97,9 @@ fs::path WriteBag(const std::string& name, const BagSpec& spec) {
   if (spec.with_tf_static) {
     bag.write("/tf_static", ros::Time(99.9),
               TfMsg(BaseFromCameraLink(), "base_link", "camera_link", 0.0));
-    bag.write("/tf_static", ros::Time(99.9),
-              TfMsg(CameraLinkFromOptical(), "camera_link", "camera_optical",
-                    0.0));
+    bag.write(
+        "/tf_static", ros::Time(99.9),
+        TfMsg(CameraLinkFromOptical(), "camera_link", "camera_optical", 0.0));
   }
   for (double t : OdometryStamps()) {
     if (spec.odom_as_tf) {
@@ -118,9 +118,9 @@ fs::path WriteBag(const std::string& name, const BagSpec& spec) {
                               "camera_optical", t));
     } else {
       const int type = spec.encoding == "mono8" ? CV_8UC1 : CV_8UC3;
-      bag.write("/cam/image_raw", ros::Time(t),
-                ImageMsg(TestImage(k, type), spec.encoding, "camera_optical",
-                         t));
+      bag.write(
+          "/cam/image_raw", ros::Time(t),
+          ImageMsg(TestImage(k, type), spec.encoding, "camera_optical", t));
     }
   }
   bag.close();

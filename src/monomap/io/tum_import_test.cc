@@ -18,10 +18,10 @@ const fs::path kDir = fs::temp_directory_path() / "monomap_tum_import_test";
 // A hand-held camera path: moving forward and sideways, turning slowly.
 Rigid3d TruePose(double t) {
   const double s = t - 1000.0;
-  return Rigid3d(YawRotation(0.2 * s) *
-                     Eigen::Quaterniond(Eigen::AngleAxisd(
-                         0.05 * std::sin(s), Eigen::Vector3d::UnitX())),
-                 Eigen::Vector3d(0.3 * s, 0.1 * std::sin(2 * s), 1.5));
+  return Rigid3d(
+      YawRotation(0.2 * s) * Eigen::Quaterniond(Eigen::AngleAxisd(
+                                 0.05 * std::sin(s), Eigen::Vector3d::UnitX())),
+      Eigen::Vector3d(0.3 * s, 0.1 * std::sin(2 * s), 1.5));
 }
 
 // A TUM sequence as distributed: ground truth at 100 Hz over [1000, 1004]
@@ -30,8 +30,9 @@ fs::path WriteTumSequence(int width, bool with_groundtruth) {
   const fs::path dir = kDir / "rgbd_dataset_freiburg1_test";
   fs::remove_all(dir);
   fs::create_directories(dir / "rgb");
-  std::string rgb = "# color images\n# file: 'rgbd_dataset_freiburg1_test.bag'"
-                    "\n# timestamp filename\n";
+  std::string rgb =
+      "# color images\n# file: 'rgbd_dataset_freiburg1_test.bag'"
+      "\n# timestamp filename\n";
   for (int k = 0; k < 60; ++k) {
     char stamp[64];
     std::snprintf(stamp, sizeof(stamp), "%.6f", 999.8 + k / 30.0);
