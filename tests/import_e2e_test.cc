@@ -15,6 +15,7 @@
 #include "monomap/io/rosbag_import.h"
 #include "monomap/io/rosbag_test_bag.h"
 #include "monomap/sim/simulate.h"
+#include "run_monomap.h"
 
 namespace monomap {
 namespace {
@@ -110,25 +111,6 @@ TEST(ImportE2e, SimulatedHallwayRoundTripsThroughARosbag) {
   EXPECT_EQ(max_pixel, 0.0);
 }
 
-struct RunResult {
-  int exit_code = -1;
-  std::string output;
-};
-
-RunResult RunMonomap(const std::string& args) {
-  const std::string cmd = std::string(MONOMAP_BINARY) + " " + args + " 2>&1";
-  RunResult r;
-  FILE* pipe = popen(cmd.c_str(), "r");
-  if (!pipe) return r;
-  std::array<char, 4096> buf;
-  size_t n;
-  while ((n = fread(buf.data(), 1, buf.size(), pipe)) > 0) {
-    r.output.append(buf.data(), n);
-  }
-  const int status = pclose(pipe);
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
 
 TEST(ImportE2e, CommandReportsAndFails) {
   // Needs the bag of the round trip test (same executable, run in order).

@@ -5,11 +5,12 @@
 // Converts robot logs and standard datasets into monomap's dataset layout
 // (docs/importing.md), so every other command reads them unchanged.
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <string>
 
 #include "monomap/exe/commands.h"
-#include "monomap/io/tum_import.h"
+#include "monomap/io/standard_import.h"
 #include "monomap/util/error.h"
 #ifdef MONOMAP_HAVE_ROSBAG
 #include "monomap/io/rosbag_import.h"
@@ -85,6 +86,47 @@ void RegisterRosbagImport(CLI::App* import) {
 #endif
 }
 
+// Odometry file or simulated odometry, and the pose gap: the same for
+// every layout that comes with ground truth only.
+void AddPosedImageOptions(CLI::App* cmd, std::filesystem::path* odometry,
+                          OdometryFromGroundTruthOptions* sim,
+                          double* max_pose_gap) {
+  cmd->add_option("--odometry", *odometry,
+                  "TUM trajectory of odometry (default: simulate it from "
+                  "groundtruth.txt)");
+  cmd->add_option("--odometry-scale-error", sim->scale_error,
+                  "Simulated odometry: systematic scale error (fraction)")
+      ->capture_default_str();
+  cmd->add_option("--odometry-translation-noise", sim->translation_noise,
+                  "Simulated odometry: random translation error (fraction of "
+                  "each step)")
+      ->capture_default_str();
+  cmd->add_option("--odometry-rotation-noise", sim->rotation_noise_deg_per_m,
+                  "Simulated odometry: random rotation error (deg per metre)")
+      ->capture_default_str();
+  cmd->add_option("--odometry-seed", sim->seed,
+                  "Simulated odometry: seed of the random errors")
+      ->capture_default_str();
+  cmd->add_option("--max-pose-gap", *max_pose_gap,
+                  "Drop images in trajectory gaps longer than this (s)")
+      ->capture_default_str();
+}
+
+void PrintImportReport(const std::string& in, const std::string& out,
+                       const ImportReport& r) {
+  std::fprintf(stderr,
+               "monomap: %s: %d of %d images imported, %d without a pose "
+               "dropped; odometry %s",
+               in.c_str(), r.frames_written, r.images_listed, r.dropped,
+               r.odometry_simulated ? "SIMULATED from ground truth"
+                                    : "from the given file");
+  if (r.odometry_simulated) {
+    std::fprintf(stderr, " (final drift %.3f m over %.2f m)", r.final_drift_m,
+                 r.path_length_m);
+  }
+  std::fprintf(stderr, " -> %s\n", out.c_str());
+}
+
 void RegisterTumImport(CLI::App* import) {
   CLI::App* cmd = import->add_subcommand(
       "tum", "TUM RGB-D sequence as distributed (rgb.txt, groundtruth.txt)");
@@ -102,42 +144,32 @@ void RegisterTumImport(CLI::App* import) {
                       "fx,fy,cx,cy[,k1,k2,p1,p2[,k3]] (pixels, plumb_bob)")
           ->delimiter(',');
   preset->excludes(intrinsics);
-  cmd->add_option("--odometry", o->odometry,
-                  "TUM trajectory of odometry (default: simulate it from "
-                  "groundtruth.txt)");
-  cmd->add_option("--odometry-scale-error", o->simulated.scale_error,
-                  "Simulated odometry: systematic scale error (fraction)")
-      ->capture_default_str();
-  cmd->add_option("--odometry-translation-noise",
-                  o->simulated.translation_noise,
-                  "Simulated odometry: random translation error (fraction of "
-                  "each step)")
-      ->capture_default_str();
-  cmd->add_option("--odometry-rotation-noise",
-                  o->simulated.rotation_noise_deg_per_m,
-                  "Simulated odometry: random rotation error (deg per metre)")
-      ->capture_default_str();
-  cmd->add_option("--odometry-seed", o->simulated.seed,
-                  "Simulated odometry: seed of the random errors")
-      ->capture_default_str();
-  cmd->add_option("--max-pose-gap", o->max_pose_gap,
-                  "Drop images in trajectory gaps longer than this (s)")
-      ->capture_default_str();
+  AddPosedImageOptions(cmd, &o->odometry, &o->simulated, &o->max_pose_gap);
   cmd->add_flag("-q,--quiet", *quiet, "No summary");
   cmd->callback([o, dir, out, quiet]() {
-    const TumImportReport r = ImportTum(*dir, *out, *o);
-    if (*quiet) return;
-    std::fprintf(stderr,
-                 "monomap: %s: %d of %d images imported, %d without a pose "
-                 "dropped; odometry %s",
-                 dir->c_str(), r.frames_written, r.images_listed, r.dropped,
-                 r.odometry_simulated ? "SIMULATED from ground truth"
-                                      : "from the given file");
-    if (r.odometry_simulated) {
-      std::fprintf(stderr, " (final drift %.3f m over %.2f m)", r.final_drift_m,
-                   r.path_length_m);
-    }
-    std::fprintf(stderr, " -> %s\n", out->c_str());
+    const ImportReport r = ImportTum(*dir, *out, *o);
+    if (!*quiet) PrintImportReport(*dir, *out, r);
+  });
+}
+
+void RegisterEurocImport(CLI::App* import) {
+  CLI::App* cmd = import->add_subcommand(
+      "euroc", "EuRoC MAV sequence, ASL layout (mav0/cam0, sensor.yaml)");
+  auto o = std::make_shared<EurocImportOptions>();
+  auto dir = std::make_shared<std::string>();
+  auto out = std::make_shared<std::string>();
+  auto quiet = std::make_shared<bool>(false);
+  cmd->add_option("dir", *dir, "Sequence directory (holding mav0/)")
+      ->required();
+  cmd->add_option("-o,--output", *out, "Dataset directory to write")
+      ->required();
+  cmd->add_option("--camera", o->camera, "Camera folder under mav0/")
+      ->capture_default_str();
+  AddPosedImageOptions(cmd, &o->odometry, &o->simulated, &o->max_pose_gap);
+  cmd->add_flag("-q,--quiet", *quiet, "No summary");
+  cmd->callback([o, dir, out, quiet]() {
+    const ImportReport r = ImportEuroc(*dir, *out, *o);
+    if (!*quiet) PrintImportReport(*dir, *out, r);
   });
 }
 
@@ -149,6 +181,7 @@ void RegisterImportCommand(CLI::App& app) {
   import->require_subcommand(1);
   RegisterRosbagImport(import);
   RegisterTumImport(import);
+  RegisterEurocImport(import);
 }
 
 }  // namespace monomap

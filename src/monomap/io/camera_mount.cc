@@ -33,8 +33,10 @@ double Scalar(const fs::path& path, const YAML::Node& node,
   return d;
 }
 
-std::vector<double> Numbers(const fs::path& path, const YAML::Node& node,
-                            const std::string& field, size_t count) {
+}  // namespace
+
+std::vector<double> YamlNumbers(const fs::path& path, const YAML::Node& node,
+                                const std::string& field, size_t count) {
   if (!node || !node.IsSequence() || node.size() != count) {
     throw InputError(
         path.string(), field,
@@ -45,37 +47,7 @@ std::vector<double> Numbers(const fs::path& path, const YAML::Node& node,
   return values;
 }
 
-// A 4x4 row-major matrix: a plain list or an OpenCV matrix map.
-Rigid3d FromMatrixNode(const fs::path& path, const YAML::Node& node,
-                       const std::string& field) {
-  std::vector<double> m;
-  if (node.IsMap()) {
-    const int rows = node["rows"] ? node["rows"].as<int>(-1) : -1;
-    const int cols = node["cols"] ? node["cols"].as<int>(-1) : -1;
-    if (rows != 4 || cols != 4) {
-      throw InputError(path.string(), field + ".rows/cols",
-                       "expected a 4x4 matrix");
-    }
-    m = Numbers(path, node["data"], field + ".data", 16);
-  } else {
-    m = Numbers(path, node, field, 16);
-  }
-  Eigen::Matrix4d t;
-  for (int i = 0; i < 16; ++i) t(i / 4, i % 4) = m[i];
-  if ((t.row(3) - Eigen::RowVector4d(0, 0, 0, 1)).cwiseAbs().maxCoeff() >
-      1e-9) {
-    throw InputError(path.string(), field, "last row must be [0 0 0 1]");
-  }
-  const Eigen::Matrix3d r = t.topLeftCorner<3, 3>();
-  if ((r.transpose() * r - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() >
-          kOrthonormalTolerance ||
-      r.determinant() < 0) {
-    throw InputError(path.string(), field,
-                     "rotation part is not a rotation (orthonormal, det +1)");
-  }
-  // Project onto SO(3) through the quaternion (removes printing noise).
-  return Rigid3d(Eigen::Quaterniond(r), t.topRightCorner<3, 1>());
-}
+namespace {
 
 Eigen::Quaterniond QuaternionField(const fs::path& path, const YAML::Node& m,
                                    const std::string& prefix) {
@@ -83,11 +55,11 @@ Eigen::Quaterniond QuaternionField(const fs::path& path, const YAML::Node& m,
   std::string field;
   if (m["rotation_xyzw"]) {
     field = prefix + ".rotation_xyzw";
-    const auto v = Numbers(path, m["rotation_xyzw"], field, 4);
+    const auto v = YamlNumbers(path, m["rotation_xyzw"], field, 4);
     q = Eigen::Quaterniond(v[3], v[0], v[1], v[2]);
   } else if (m["rotation_wxyz"]) {
     field = prefix + ".rotation_wxyz";
-    const auto v = Numbers(path, m["rotation_wxyz"], field, 4);
+    const auto v = YamlNumbers(path, m["rotation_wxyz"], field, 4);
     q = Eigen::Quaterniond(v[0], v[1], v[2], v[3]);
   } else if (m["rotation"] && m["rotation"].IsMap()) {
     field = prefix + ".rotation";
@@ -119,7 +91,8 @@ Rigid3d FromTranslationQuaternion(const fs::path& path, const YAML::Node& m,
                        "rotation_xyzw, or a 4x4 matrix)");
     }
   }
-  const auto t = Numbers(path, m["translation"], prefix + ".translation", 3);
+  const auto t =
+      YamlNumbers(path, m["translation"], prefix + ".translation", 3);
   return Rigid3d(QuaternionField(path, m, prefix),
                  Eigen::Vector3d(t[0], t[1], t[2]));
 }
@@ -127,7 +100,7 @@ Rigid3d FromTranslationQuaternion(const fs::path& path, const YAML::Node& m,
 Rigid3d FromNode(const fs::path& path, const YAML::Node& node,
                  const std::string& key) {
   if (node.IsSequence() || (node.IsMap() && node["data"])) {
-    return FromMatrixNode(path, node, key);
+    return ParseRigidMatrix(path, node, key);
   }
   if (node.IsMap()) return FromTranslationQuaternion(path, node, key);
   throw InputError(path.string(), key,
@@ -136,26 +109,60 @@ Rigid3d FromNode(const fs::path& path, const YAML::Node& node,
 
 }  // namespace
 
-Rigid3d ParseCameraMount(const std::string& yaml_text, const fs::path& path) {
-  // OpenCV's FileStorage writes "%YAML:1.0", which is not YAML 1.2: drop it.
+// A 4x4 row-major matrix: a plain list or an OpenCV matrix map.
+Rigid3d ParseRigidMatrix(const fs::path& path, const YAML::Node& node,
+                         const std::string& field) {
+  std::vector<double> m;
+  if (node.IsMap()) {
+    const int rows = node["rows"] ? node["rows"].as<int>(-1) : -1;
+    const int cols = node["cols"] ? node["cols"].as<int>(-1) : -1;
+    if (rows != 4 || cols != 4) {
+      throw InputError(path.string(), field + ".rows/cols",
+                       "expected a 4x4 matrix");
+    }
+    m = YamlNumbers(path, node["data"], field + ".data", 16);
+  } else {
+    m = YamlNumbers(path, node, field, 16);
+  }
+  Eigen::Matrix4d t;
+  for (int i = 0; i < 16; ++i) t(i / 4, i % 4) = m[i];
+  if ((t.row(3) - Eigen::RowVector4d(0, 0, 0, 1)).cwiseAbs().maxCoeff() >
+      1e-9) {
+    throw InputError(path.string(), field, "last row must be [0 0 0 1]");
+  }
+  const Eigen::Matrix3d r = t.topLeftCorner<3, 3>();
+  if ((r.transpose() * r - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() >
+          kOrthonormalTolerance ||
+      r.determinant() < 0) {
+    throw InputError(path.string(), field,
+                     "rotation part is not a rotation (orthonormal, det +1)");
+  }
+  // Project onto SO(3) through the quaternion (removes printing noise).
+  return Rigid3d(Eigen::Quaterniond(r), t.topRightCorner<3, 1>());
+}
+
+YAML::Node LoadYamlText(const std::string& yaml_text, const fs::path& path) {
   std::string text = yaml_text;
-  if (text.rfind("%YAML", 0) == 0) text = text.substr(text.find('\n') + 1);
-  YAML::Node root;
+  if (text.rfind("%YAML:", 0) == 0) text = text.substr(text.find('\n') + 1);
   try {
-    root = YAML::Load(text);
+    return YAML::Load(text);
   } catch (const YAML::Exception& e) {
     throw InputError(path.string(), e.mark.line + 1,
                      "malformed YAML: " + e.msg);
   }
+}
+
+Rigid3d ParseCameraMount(const std::string& yaml_text, const fs::path& path) {
+  const YAML::Node root = LoadYamlText(yaml_text, path);
   if (!root.IsMap()) throw InputError(path.string() + ": not a YAML mapping");
   if (root["base_from_cam"]) {
     return FromNode(path, root["base_from_cam"], "base_from_cam");
   }
   if (root["T_base_cam"]) {
-    return FromMatrixNode(path, root["T_base_cam"], "T_base_cam");
+    return ParseRigidMatrix(path, root["T_base_cam"], "T_base_cam");
   }
   if (root["T_cam_base"]) {
-    return FromMatrixNode(path, root["T_cam_base"], "T_cam_base").Inverse();
+    return ParseRigidMatrix(path, root["T_cam_base"], "T_cam_base").Inverse();
   }
   throw InputError(path.string(), "base_from_cam",
                    "missing (expected base_from_cam, T_base_cam or "

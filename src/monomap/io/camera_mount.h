@@ -12,6 +12,7 @@
 
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "monomap/geometry/rigid3.h"
 
@@ -24,6 +25,24 @@ namespace monomap {
 // not of unit length.
 Rigid3d ParseCameraMount(const std::string& yaml_text,
                          const std::filesystem::path& path);
+
+// Parses YAML text, also as OpenCV's FileStorage writes it (a "%YAML:1.0"
+// first line, which is not YAML 1.2). Throws InputError naming `path` and
+// the line if malformed.
+YAML::Node LoadYamlText(const std::string& text,
+                        const std::filesystem::path& path);
+
+// The `count` finite numbers of a YAML list; throws InputError naming
+// `path` and `field` otherwise.
+std::vector<double> YamlNumbers(const std::filesystem::path& path,
+                                const YAML::Node& node,
+                                const std::string& field, size_t count);
+
+// A 4x4 row-major rigid transform: a list of 16 numbers or an OpenCV
+// matrix map {rows: 4, cols: 4, data: [...]}. Throws InputError naming
+// `path` and `field` unless it is one (see ParseCameraMount).
+Rigid3d ParseRigidMatrix(const std::filesystem::path& path,
+                         const YAML::Node& node, const std::string& field);
 
 // Reads and parses `path`.
 Rigid3d ReadCameraMount(const std::filesystem::path& path);

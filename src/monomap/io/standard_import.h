@@ -1,4 +1,5 @@
-// Imports a TUM RGB-D sequence as distributed (rgb.txt with its comment
+// Imports standard dataset layouts into monomap's (docs/importing.md).
+// TUM RGB-D: a sequence as distributed (rgb.txt with its comment
 // header, rgb/*.png, groundtruth.txt; no calibration, no odometry) into
 // monomap's dataset layout (docs/importing.md). The intrinsics come from
 // the user or a named preset; the odometry from a file or, honestly
@@ -49,7 +50,7 @@ struct TumImportOptions {
   void Check() const;
 };
 
-struct TumImportReport {
+struct ImportReport {
   int images_listed = 0;
   int frames_written = 0;
   // Images with no pose (outside the trajectory or in a gap).
@@ -61,6 +62,19 @@ struct TumImportReport {
   Camera camera;
 };
 
+struct EurocImportOptions {
+  // Camera folder under mav0/ ("cam0" or "cam1").
+  std::string camera = "cam0";
+  // A TUM trajectory of odometry (world_from_cam); empty: simulate it from
+  // the ground truth (state_groundtruth_estimate0) with `simulated`.
+  std::filesystem::path odometry;
+  OdometryFromGroundTruthOptions simulated;
+  // As TumImportOptions::max_pose_gap.
+  double max_pose_gap = 0.1;
+
+  void Check() const;
+};
+
 // The published calibration of the TUM RGB-D benchmark's cameras (fr1,
 // fr2, fr3; 640x480). Throws OptionsError for another name.
 Camera TumPresetCamera(const std::string& name);
@@ -68,8 +82,17 @@ Camera TumPresetCamera(const std::string& name);
 // Reads the sequence in `tum_dir` and writes the dataset to `out_dir`
 // atomically. Images are hard-linked when possible, copied otherwise.
 // Throws InputError naming file and line or field; nothing is written then.
-TumImportReport ImportTum(const std::filesystem::path& tum_dir,
-                          const std::filesystem::path& out_dir,
-                          const TumImportOptions& options);
+ImportReport ImportTum(const std::filesystem::path& tum_dir,
+                       const std::filesystem::path& out_dir,
+                       const TumImportOptions& options);
+
+// Reads an EuRoC MAV sequence in the ASL layout (DIR/mav0 or DIR itself:
+// CAM/data.csv, CAM/data/*.png, CAM/sensor.yaml with intrinsics,
+// radial-tangential distortion and T_BS, state_groundtruth_estimate0/
+// data.csv of the body) and writes the dataset to `out_dir` atomically;
+// the ground truth becomes the camera's (world_from_body * T_BS).
+ImportReport ImportEuroc(const std::filesystem::path& dir,
+                         const std::filesystem::path& out_dir,
+                         const EurocImportOptions& options);
 
 }  // namespace monomap
