@@ -1,5 +1,6 @@
 // monomap import rosbag BAG -o DATASET --image-topic T --camera-info-topic T
 //   (--odom-topic T | --odom-tf odom:base_link) [--base-frame F] ...
+// monomap import euroc DIR -o DATASET, monomap import kitti SEQ -o DATASET
 // monomap import tum DIR -o DATASET (--preset fr1 | --intrinsics fx,fy,cx,cy)
 //   [--odometry FILE | --odometry-scale-error S ... --odometry-seed N]
 // Converts robot logs and standard datasets into monomap's dataset layout
@@ -93,7 +94,7 @@ void AddPosedImageOptions(CLI::App* cmd, std::filesystem::path* odometry,
                           double* max_pose_gap) {
   cmd->add_option("--odometry", *odometry,
                   "TUM trajectory of odometry (default: simulate it from "
-                  "groundtruth.txt)");
+                  "the ground truth)");
   cmd->add_option("--odometry-scale-error", sim->scale_error,
                   "Simulated odometry: systematic scale error (fraction)")
       ->capture_default_str();
@@ -173,6 +174,29 @@ void RegisterEurocImport(CLI::App* import) {
   });
 }
 
+void RegisterKittiImport(CLI::App* import) {
+  CLI::App* cmd = import->add_subcommand(
+      "kitti", "KITTI odometry sequence (calib.txt, times.txt, poses)");
+  auto o = std::make_shared<KittiImportOptions>();
+  auto dir = std::make_shared<std::string>();
+  auto out = std::make_shared<std::string>();
+  auto quiet = std::make_shared<bool>(false);
+  cmd->add_option("sequence", *dir, "Sequence directory, e.g. sequences/00")
+      ->required();
+  cmd->add_option("-o,--output", *out, "Dataset directory to write")
+      ->required();
+  cmd->add_option("--camera", o->camera, "Camera 0-3 (image_N, PN)")
+      ->capture_default_str();
+  cmd->add_option("--poses", o->poses,
+                  "Ground-truth poses (default: SEQ/../../poses/NN.txt)");
+  AddPosedImageOptions(cmd, &o->odometry, &o->simulated, &o->max_pose_gap);
+  cmd->add_flag("-q,--quiet", *quiet, "No summary");
+  cmd->callback([o, dir, out, quiet]() {
+    const ImportReport r = ImportKitti(*dir, *out, *o);
+    if (!*quiet) PrintImportReport(*dir, *out, r);
+  });
+}
+
 }  // namespace
 
 void RegisterImportCommand(CLI::App& app) {
@@ -182,6 +206,7 @@ void RegisterImportCommand(CLI::App& app) {
   RegisterRosbagImport(import);
   RegisterTumImport(import);
   RegisterEurocImport(import);
+  RegisterKittiImport(import);
 }
 
 }  // namespace monomap

@@ -1,6 +1,7 @@
 #include "monomap/io/standard_import.h"
 
 #include <cmath>
+#include <cstdio>
 #include <opencv2/imgcodecs.hpp>
 #include <random>
 
@@ -34,6 +35,12 @@ void TumImportOptions::Check() const {
 void EurocImportOptions::Check() const {
   CheckOption(!camera.empty(), "euroc.camera", "must be set");
   CheckOption(max_pose_gap > 0, "euroc.max_pose_gap", "must be > 0");
+  simulated.Check();
+}
+
+void KittiImportOptions::Check() const {
+  CheckOption(camera >= 0 && camera <= 3, "kitti.camera", "must be 0 to 3");
+  CheckOption(max_pose_gap > 0, "kitti.max_pose_gap", "must be > 0");
   simulated.Check();
 }
 
@@ -359,6 +366,108 @@ ImportReport ImportEuroc(const fs::path& dir, const fs::path& out_dir,
   }
   in.trajectory =
       o.odometry.empty() ? in.groundtruth : ReadTumTrajectory(o.odometry);
+  return ImportPosedImages(in, camera, out_dir, o.odometry.empty(), o.simulated,
+                           o.max_pose_gap);
+}
+
+namespace {
+
+// The 12 numbers of a KITTI line "[KEY:] m00 m01 ... m23" (3x4 row-major).
+Eigen::Matrix<double, 3, 4> KittiMatrix(const TextLine& line,
+                                        const fs::path& path, bool keyed) {
+  auto tokens = SplitWhitespace(line.text);
+  if (keyed && !tokens.empty()) tokens.erase(tokens.begin());
+  if (tokens.size() != 12) {
+    throw InputError(path.string(), line.number,
+                     "expected 12 numbers (3x4 row-major), got " +
+                         std::to_string(tokens.size()));
+  }
+  Eigen::Matrix<double, 3, 4> m;
+  for (int i = 0; i < 12; ++i) {
+    if (!ParseDouble(tokens[i], &m(i / 4, i % 4))) {
+      throw InputError(path.string(), line.number,
+                       "value '" + tokens[i] + "' is not a number");
+    }
+  }
+  return m;
+}
+
+// calib.txt's PN -> intrinsics and cam0_from_camN (rectified: a pure
+// translation).
+Camera KittiCamera(const fs::path& path, int n, Rigid3d* cam0_from_cam) {
+  const std::string key = "P" + std::to_string(n) + ":";
+  for (const TextLine& line : ReadDataLines(path)) {
+    if (line.text.rfind(key, 0) != 0) continue;
+    const Eigen::Matrix<double, 3, 4> p = KittiMatrix(line, path, true);
+    Camera c;
+    c.fx = p(0, 0), c.fy = p(1, 1), c.cx = p(0, 2), c.cy = p(1, 2);
+    if (c.fx <= 0 || c.fy <= 0) {
+      throw InputError(path.string(), line.number, "focal length <= 0");
+    }
+    // PN = K [I | t]: x_in_camN = x_in_cam0 + t.
+    const Eigen::Vector3d t = p.leftCols<3>().inverse() * p.col(3);
+    *cam0_from_cam = Rigid3d(Eigen::Quaterniond::Identity(), -t);
+    return c;
+  }
+  throw InputError(path.string(), key.substr(0, key.size() - 1), "missing");
+}
+
+}  // namespace
+
+ImportReport ImportKitti(const fs::path& seq, const fs::path& out_dir,
+                         const KittiImportOptions& o) {
+  o.Check();
+  Rigid3d cam0_from_cam;
+  Camera camera = KittiCamera(seq / "calib.txt", o.camera, &cam0_from_cam);
+  const fs::path poses_path = !o.poses.empty()
+                                  ? o.poses
+                                  : seq.parent_path().parent_path() / "poses" /
+                                        (seq.filename().string() + ".txt");
+  PosedImages in;
+  in.root = seq;
+  in.list = seq / "times.txt";
+  in.out_prefix = "rgb/";
+  const std::string folder = "image_" + std::to_string(o.camera) + "/";
+  for (const TextLine& line : ReadDataLines(in.list)) {
+    double t = 0;
+    if (!ParseDouble(line.text, &t)) {
+      throw InputError(in.list.string(), line.number,
+                       "'" + line.text + "' is not a time in seconds");
+    }
+    char name[32];
+    std::snprintf(name, sizeof(name), "%06zu.png", in.images.size());
+    in.images.push_back({t, folder + name, line.number});
+  }
+  if (fs::exists(poses_path)) {
+    const std::vector<TextLine> lines = ReadDataLines(poses_path);
+    if (lines.size() != in.images.size()) {
+      throw InputError(poses_path.string() + ": " +
+                       std::to_string(lines.size()) + " poses but " +
+                       in.list.string() + " has " +
+                       std::to_string(in.images.size()) + " times");
+    }
+    for (size_t i = 0; i < lines.size(); ++i) {
+      const auto m = KittiMatrix(lines[i], poses_path, false);
+      const Rigid3d world_from_cam0(
+          Eigen::Quaterniond(Eigen::Matrix3d(m.leftCols<3>())), m.col(3));
+      in.groundtruth.push_back(
+          {in.images[i].timestamp, world_from_cam0 * cam0_from_cam});
+    }
+  } else if (o.odometry.empty()) {
+    throw InputError(poses_path.string() +
+                     ": not found; without poses odometry cannot be "
+                     "simulated (pass --poses FILE or --odometry FILE)");
+  }
+  in.trajectory =
+      o.odometry.empty() ? in.groundtruth : ReadTumTrajectory(o.odometry);
+  const cv::Mat first =
+      cv::imread((seq / in.images.front().path).string(), cv::IMREAD_UNCHANGED);
+  if (first.empty()) {
+    throw InputError((seq / in.images.front().path).string() +
+                     ": cannot read the image");
+  }
+  camera.width = first.cols;
+  camera.height = first.rows;
   return ImportPosedImages(in, camera, out_dir, o.odometry.empty(), o.simulated,
                            o.max_pose_gap);
 }

@@ -75,6 +75,22 @@ struct EurocImportOptions {
   void Check() const;
 };
 
+struct KittiImportOptions {
+  // Camera: 0, 1 (grey) or 2, 3 (colour) = image_N and PN in calib.txt.
+  int camera = 0;
+  // Ground-truth poses of camera 0 (KITTI poses/NN.txt); empty: SEQ/../../
+  // poses/NN.txt if it exists.
+  std::filesystem::path poses;
+  // A TUM trajectory of odometry (world_from_cam); empty: simulate it from
+  // the poses with `simulated`.
+  std::filesystem::path odometry;
+  OdometryFromGroundTruthOptions simulated;
+  // As TumImportOptions::max_pose_gap (KITTI runs at 10 Hz).
+  double max_pose_gap = 0.2;
+
+  void Check() const;
+};
+
 // The published calibration of the TUM RGB-D benchmark's cameras (fr1,
 // fr2, fr3; 640x480). Throws OptionsError for another name.
 Camera TumPresetCamera(const std::string& name);
@@ -94,5 +110,14 @@ ImportReport ImportTum(const std::filesystem::path& tum_dir,
 ImportReport ImportEuroc(const std::filesystem::path& dir,
                          const std::filesystem::path& out_dir,
                          const EurocImportOptions& options);
+
+// Reads a KITTI odometry sequence (SEQ/calib.txt, SEQ/times.txt,
+// SEQ/image_N/*.png and the poses file, 3x4 row-major world_from_cam0 per
+// line) and writes the dataset to `out_dir` atomically. The images are
+// rectified: the camera has no distortion; camera N's poses are camera 0's
+// moved by the baseline in PN.
+ImportReport ImportKitti(const std::filesystem::path& sequence,
+                         const std::filesystem::path& out_dir,
+                         const KittiImportOptions& options);
 
 }  // namespace monomap

@@ -265,5 +265,89 @@ TEST(EurocImport, ErrorsNameTheField) {
   EXPECT_NE(e.find("sensor.yaml"), std::string::npos) << e;
 }
 
+// A KITTI odometry sequence: 20 frames at 10 Hz, rectified cameras 0 and 2
+// with a 0.54 m baseline (P2 = K [I | t]), poses of camera 0.
+fs::path WriteKittiSequence() {
+  const fs::path seq = kDir / "dataset" / "sequences" / "07";
+  fs::remove_all(kDir / "dataset");
+  fs::create_directories(seq / "image_0");
+  fs::create_directories(seq / "image_2");
+  fs::create_directories(kDir / "dataset" / "poses");
+  WriteFileAtomic(seq / "calib.txt",
+                  "P0: 70 0 40 0 0 70 30 0 0 0 1 0\n"
+                  "P1: 70 0 40 -37.8 0 70 30 0 0 0 1 0\n"
+                  "P2: 70 0 40 4.2 0 70 30 0.14 0 0 1 0.003\n"
+                  "P3: 70 0 40 -33.6 0 70 30 0.14 0 0 1 0.003\n"
+                  "Tr: 1 0 0 0 0 1 0 0 0 0 1 0\n");
+  std::string times, poses;
+  for (int k = 0; k < 20; ++k) {
+    char line[512];
+    std::snprintf(line, sizeof(line), "%e\n", 0.1 * k);
+    times += line;
+    const Eigen::Matrix4d m = TruePose(1000.0 + 0.1 * k).ToMatrix4();
+    std::ostringstream row;
+    row.precision(17);
+    for (int i = 0; i < 12; ++i) row << (i ? " " : "") << m(i / 4, i % 4);
+    poses += row.str() + "\n";
+    char name[32];
+    std::snprintf(name, sizeof(name), "%06d.png", k);
+    for (const char* folder : {"image_0", "image_2"}) {
+      cv::imwrite((seq / folder / name).string(),
+                  cv::Mat(60, 80, CV_8UC1, cv::Scalar(5 * k)));
+    }
+  }
+  WriteFileAtomic(seq / "times.txt", times);
+  WriteFileAtomic(kDir / "dataset" / "poses" / "07.txt", poses);
+  return seq;
+}
+
+TEST(KittiImport, PosesOfCameraZeroAndTwo) {
+  const fs::path seq = WriteKittiSequence();
+  KittiImportOptions o;
+  o.simulated = ExactOdometry().simulated;
+  for (int camera : {0, 2}) {
+    o.camera = camera;
+    const ImportReport r = ImportKitti(seq, kDir / "kitti", o);
+    EXPECT_EQ(r.frames_written, 20);
+    EXPECT_EQ(r.dropped, 0);
+    const Dataset ds = LoadDataset(kDir / "kitti");
+    ASSERT_EQ(ds.frames.size(), 20u);
+    EXPECT_EQ(ds.camera.width, 80);
+    EXPECT_DOUBLE_EQ(ds.camera.cx, 40);
+    // P2 = K [I | t] with t = K^-1 (4.2, 0.14, 0.003) = (0.06, 0, 0.003)
+    // -> camera 2 sits at -t in camera 0.
+    const Rigid3d cam0_from_cam(
+        Eigen::Quaterniond::Identity(),
+        camera == 0 ? Eigen::Vector3d::Zero()
+                    : Eigen::Vector3d(-(4.2 - 40 * 0.003) / 70,
+                                      -(0.14 - 30 * 0.003) / 70, -0.003));
+    double worst = 0;
+    for (const DatasetFrame& f : ds.frames) {
+      const Rigid3d expected = TruePose(1000.0 + f.timestamp) * cam0_from_cam;
+      worst = std::max(
+          worst, (f.odometry_world_from_cam.translation - expected.translation)
+                         .norm() +
+                     AngleBetween(f.odometry_world_from_cam.rotation,
+                                  expected.rotation));
+    }
+    EXPECT_LT(worst, 1e-6) << "camera " << camera;
+  }
+}
+
+TEST(KittiImport, MismatchedPosesNameTheFiles) {
+  const fs::path seq = WriteKittiSequence();
+  WriteFileAtomic(seq / "times.txt",
+                  ReadFileToString(seq / "times.txt") + "2.000000e+00\n");
+  std::string e;
+  try {
+    ImportKitti(seq, kDir / "kitti_failed", KittiImportOptions());
+  } catch (const InputError& error) {
+    e = error.what();
+  }
+  EXPECT_NE(e.find("07.txt: 20 poses but "), std::string::npos) << e;
+  EXPECT_NE(e.find("times.txt has 21 times"), std::string::npos) << e;
+  EXPECT_FALSE(fs::exists(kDir / "kitti_failed"));
+}
+
 }  // namespace
 }  // namespace monomap
