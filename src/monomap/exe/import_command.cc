@@ -1,6 +1,7 @@
 // monomap import rosbag BAG -o DATASET --image-topic T --camera-info-topic T
 //   (--odom-topic T | --odom-tf odom:base_link) [--base-frame F] ...
 // monomap import euroc DIR -o DATASET, monomap import kitti SEQ -o DATASET
+// monomap import video FILE -o DATASET --camera YAML --odometry FILE
 // monomap import tum DIR -o DATASET (--preset fr1 | --intrinsics fx,fy,cx,cy)
 //   [--odometry FILE | --odometry-scale-error S ... --odometry-seed N]
 // Converts robot logs and standard datasets into monomap's dataset layout
@@ -197,6 +198,35 @@ void RegisterKittiImport(CLI::App* import) {
   });
 }
 
+void RegisterVideoImport(CLI::App* import) {
+  CLI::App* cmd = import->add_subcommand(
+      "video", "Video file (anything OpenCV reads) plus an odometry file");
+  auto o = std::make_shared<VideoImportOptions>();
+  auto video = std::make_shared<std::string>();
+  auto out = std::make_shared<std::string>();
+  auto quiet = std::make_shared<bool>(false);
+  cmd->add_option("video", *video, "Video file")->required();
+  cmd->add_option("-o,--output", *out, "Dataset directory to write")
+      ->required();
+  cmd->add_option("--camera", o->camera_yaml, "camera_info YAML")->required();
+  cmd->add_option("--odometry", o->odometry,
+                  "TUM trajectory of odometry (world_from_cam)")
+      ->required();
+  cmd->add_option("--groundtruth", o->groundtruth,
+                  "TUM ground truth, kept for evaluation");
+  cmd->add_option("--start-time", o->start_time,
+                  "Time of the first frame on the odometry's clock (s)")
+      ->capture_default_str();
+  cmd->add_option("--max-pose-gap", o->max_pose_gap,
+                  "Drop frames in odometry gaps longer than this (s)")
+      ->capture_default_str();
+  cmd->add_flag("-q,--quiet", *quiet, "No summary");
+  cmd->callback([o, video, out, quiet]() {
+    const ImportReport r = ImportVideo(*video, *out, *o);
+    if (!*quiet) PrintImportReport(*video, *out, r);
+  });
+}
+
 }  // namespace
 
 void RegisterImportCommand(CLI::App& app) {
@@ -207,6 +237,7 @@ void RegisterImportCommand(CLI::App& app) {
   RegisterTumImport(import);
   RegisterEurocImport(import);
   RegisterKittiImport(import);
+  RegisterVideoImport(import);
 }
 
 }  // namespace monomap

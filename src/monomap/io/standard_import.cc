@@ -3,9 +3,11 @@
 #include <cmath>
 #include <cstdio>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/videoio.hpp>
 #include <random>
 
 #include "monomap/io/camera_mount.h"
+#include "monomap/io/dataset.h"
 #include "monomap/io/dataset_writer.h"
 #include "monomap/io/trajectory_io.h"
 #include "monomap/util/error.h"
@@ -42,6 +44,13 @@ void KittiImportOptions::Check() const {
   CheckOption(camera >= 0 && camera <= 3, "kitti.camera", "must be 0 to 3");
   CheckOption(max_pose_gap > 0, "kitti.max_pose_gap", "must be > 0");
   simulated.Check();
+}
+
+void VideoImportOptions::Check() const {
+  CheckOption(!camera_yaml.empty(), "video.camera_yaml", "must be set");
+  CheckOption(!odometry.empty(), "video.odometry", "must be set");
+  CheckOption(std::isfinite(start_time), "video.start_time", "must be finite");
+  CheckOption(max_pose_gap > 0, "video.max_pose_gap", "must be > 0");
 }
 
 Camera TumPresetCamera(const std::string& name) {
@@ -470,6 +479,49 @@ ImportReport ImportKitti(const fs::path& seq, const fs::path& out_dir,
   camera.height = first.rows;
   return ImportPosedImages(in, camera, out_dir, o.odometry.empty(), o.simulated,
                            o.max_pose_gap);
+}
+
+ImportReport ImportVideo(const fs::path& video, const fs::path& out_dir,
+                         const VideoImportOptions& o) {
+  o.Check();
+  const Camera camera = ReadCameraYaml(o.camera_yaml);
+  cv::VideoCapture capture(video.string());
+  if (!capture.isOpened()) {
+    throw InputError(video.string() + ": cannot open the video");
+  }
+  // The frames go to a scratch directory beside the output (removed on
+  // return), from which ImportPosedImages hard-links them.
+  fs::path base = out_dir;
+  if (!base.has_filename()) base = base.parent_path();  // "DIR/"
+  AtomicDirectory frames(base.string() + ".frames");
+  PosedImages in;
+  in.root = frames.path();
+  in.list = video;
+  in.out_prefix = "rgb/";
+  cv::Mat image;
+  while (capture.read(image)) {
+    const int index = static_cast<int>(in.images.size());
+    if (image.cols != camera.width || image.rows != camera.height) {
+      throw InputError(
+          video.string() + ": frame " + std::to_string(index) + " is " +
+          std::to_string(image.cols) + "x" + std::to_string(image.rows) +
+          " but " + o.camera_yaml.string() + " says " +
+          std::to_string(camera.width) + "x" + std::to_string(camera.height));
+    }
+    const double t = o.start_time + capture.get(cv::CAP_PROP_POS_MSEC) * 1e-3;
+    char name[32];
+    std::snprintf(name, sizeof(name), "%06d.png", index);
+    if (!cv::imwrite((frames.path() / name).string(), image)) {
+      throw OutputError((frames.path() / name).string() + ": cannot write");
+    }
+    in.images.push_back({t, name, index + 1});
+  }
+  if (in.images.empty()) {
+    throw InputError(video.string() + ": no frame could be decoded");
+  }
+  in.trajectory = ReadTumTrajectory(o.odometry);
+  if (!o.groundtruth.empty()) in.groundtruth = ReadTumTrajectory(o.groundtruth);
+  return ImportPosedImages(in, camera, out_dir, false, {}, o.max_pose_gap);
 }
 
 }  // namespace monomap

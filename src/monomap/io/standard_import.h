@@ -91,6 +91,23 @@ struct KittiImportOptions {
   void Check() const;
 };
 
+struct VideoImportOptions {
+  // camera_info YAML of the video's camera (required).
+  std::filesystem::path camera_yaml;
+  // TUM trajectory of odometry (world_from_cam), stamped on the same clock
+  // as `start_time` (required).
+  std::filesystem::path odometry;
+  // Optional TUM ground truth, copied for evaluation.
+  std::filesystem::path groundtruth;
+  // Time (s) of the video's first frame on the odometry's clock; frame i
+  // is at start_time + its position in the video.
+  double start_time = 0.0;
+  // As TumImportOptions::max_pose_gap.
+  double max_pose_gap = 0.2;
+
+  void Check() const;
+};
+
 // The published calibration of the TUM RGB-D benchmark's cameras (fr1,
 // fr2, fr3; 640x480). Throws OptionsError for another name.
 Camera TumPresetCamera(const std::string& name);
@@ -119,5 +136,13 @@ ImportReport ImportEuroc(const std::filesystem::path& dir,
 ImportReport ImportKitti(const std::filesystem::path& sequence,
                          const std::filesystem::path& out_dir,
                          const KittiImportOptions& options);
+
+// Reads a video file (anything OpenCV's videoio opens), writes its frames
+// as PNG with the odometry interpolated at each frame's time, and writes
+// the dataset to `out_dir` atomically. Frames without odometry are dropped
+// and counted; a frame of another size than camera_yaml says is an error.
+ImportReport ImportVideo(const std::filesystem::path& video,
+                         const std::filesystem::path& out_dir,
+                         const VideoImportOptions& options);
 
 }  // namespace monomap

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/videoio.hpp>
 #include <sstream>
 
 #include "monomap/io/dataset.h"
@@ -347,6 +348,60 @@ TEST(KittiImport, MismatchedPosesNameTheFiles) {
   EXPECT_NE(e.find("07.txt: 20 poses but "), std::string::npos) << e;
   EXPECT_NE(e.find("times.txt has 21 times"), std::string::npos) << e;
   EXPECT_FALSE(fs::exists(kDir / "kitti_failed"));
+}
+
+TEST(VideoImport, FramesGetTheOdometryAtTheirTime) {
+  fs::create_directories(kDir);
+  const fs::path video = kDir / "run.avi";
+  {
+    cv::VideoWriter writer(video.string(),
+                           cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 10.0,
+                           cv::Size(80, 60));
+    ASSERT_TRUE(writer.isOpened());
+    for (int k = 0; k < 20; ++k) {
+      writer.write(cv::Mat(60, 80, CV_8UC3, cv::Scalar(10 * k, 50, 200)));
+    }
+  }
+  Camera c;
+  c.width = 80, c.height = 60, c.fx = c.fy = 70, c.cx = 39.5, c.cy = 29.5;
+  WriteCameraYaml(kDir / "video_camera.yaml", c, "test");
+  std::vector<TimedPose> odometry;  // 20 Hz over [100, 101.5] s
+  for (int i = 0; i <= 30; ++i) {
+    odometry.push_back({100.0 + 0.05 * i, TruePose(1000.0 + 0.05 * i)});
+  }
+  WriteTumTrajectory(kDir / "video_odometry.txt", odometry);
+  VideoImportOptions o;
+  o.camera_yaml = kDir / "video_camera.yaml";
+  o.odometry = kDir / "video_odometry.txt";
+  o.start_time = 100.0;
+  const ImportReport r = ImportVideo(video, kDir / "video", o);
+  EXPECT_EQ(r.images_listed, 20);
+  EXPECT_EQ(r.dropped, 4);  // 101.6 .. 101.9 s, after the odometry
+  EXPECT_FALSE(fs::exists(kDir / "video.frames"));
+  const Dataset ds = LoadDataset(kDir / "video");
+  ASSERT_EQ(ds.frames.size(), 16u);
+  double worst = 0;
+  for (size_t i = 0; i < ds.frames.size(); ++i) {
+    EXPECT_NEAR(ds.frames[i].timestamp, 100.0 + 0.1 * i, 1e-6);
+    const Rigid3d expected = TruePose(1000.0 + 0.1 * i);
+    const Rigid3d& pose = ds.frames[i].odometry_world_from_cam;
+    worst = std::max(worst, (pose.translation - expected.translation).norm() +
+                                AngleBetween(pose.rotation, expected.rotation));
+  }
+  EXPECT_LT(worst, 1e-6);
+  // Colour survives the MJPEG round trip roughly (frame 5: B = 50).
+  EXPECT_NEAR(cv::mean(ds.LoadImage(5, true))[0], 50.0, 6.0);
+
+  c.width = 64;
+  WriteCameraYaml(kDir / "video_camera.yaml", c, "test");
+  std::string e;
+  try {
+    ImportVideo(video, kDir / "video_failed", o);
+  } catch (const InputError& error) {
+    e = error.what();
+  }
+  EXPECT_NE(e.find("run.avi: frame 0 is 80x60 but"), std::string::npos) << e;
+  EXPECT_FALSE(fs::exists(kDir / "video_failed"));
 }
 
 }  // namespace
