@@ -421,6 +421,26 @@ Camera KittiCamera(const fs::path& path, int n, Rigid3d* cam0_from_cam) {
   throw InputError(path.string(), key.substr(0, key.size() - 1), "missing");
 }
 
+// The poses file: one 3x4 world_from_cam0 per time of `in.images`.
+std::vector<TimedPose> ReadKittiPoses(const fs::path& path,
+                                      const PosedImages& in,
+                                      const Rigid3d& cam0_from_cam) {
+  const std::vector<TextLine> lines = ReadDataLines(path);
+  if (lines.size() != in.images.size()) {
+    throw InputError(path.string() + ": " + std::to_string(lines.size()) +
+                     " poses but " + in.list.string() + " has " +
+                     std::to_string(in.images.size()) + " times");
+  }
+  std::vector<TimedPose> poses;
+  for (size_t i = 0; i < lines.size(); ++i) {
+    const auto m = KittiMatrix(lines[i], path, false);
+    const Rigid3d world_from_cam0(
+        Eigen::Quaterniond(Eigen::Matrix3d(m.leftCols<3>())), m.col(3));
+    poses.push_back({in.images[i].timestamp, world_from_cam0 * cam0_from_cam});
+  }
+  return poses;
+}
+
 }  // namespace
 
 ImportReport ImportKitti(const fs::path& seq, const fs::path& out_dir,
@@ -448,20 +468,7 @@ ImportReport ImportKitti(const fs::path& seq, const fs::path& out_dir,
     in.images.push_back({t, folder + name, line.number});
   }
   if (fs::exists(poses_path)) {
-    const std::vector<TextLine> lines = ReadDataLines(poses_path);
-    if (lines.size() != in.images.size()) {
-      throw InputError(poses_path.string() + ": " +
-                       std::to_string(lines.size()) + " poses but " +
-                       in.list.string() + " has " +
-                       std::to_string(in.images.size()) + " times");
-    }
-    for (size_t i = 0; i < lines.size(); ++i) {
-      const auto m = KittiMatrix(lines[i], poses_path, false);
-      const Rigid3d world_from_cam0(
-          Eigen::Quaterniond(Eigen::Matrix3d(m.leftCols<3>())), m.col(3));
-      in.groundtruth.push_back(
-          {in.images[i].timestamp, world_from_cam0 * cam0_from_cam});
-    }
+    in.groundtruth = ReadKittiPoses(poses_path, in, cam0_from_cam);
   } else if (o.odometry.empty()) {
     throw InputError(poses_path.string() +
                      ": not found; without poses odometry cannot be "
