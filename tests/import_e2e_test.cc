@@ -56,7 +56,8 @@ fs::path WriteBagOf(const Dataset& sim) {
   return path;
 }
 
-TEST(ImportE2e, SimulatedHallwayRoundTripsThroughARosbag) {
+// A short simulated hallway run (25 frames, 160x120) in kRoot/sim.
+Dataset SimulateHallway() {
   fs::remove_all(kRoot);
   SimulationOptions so;
   so.world = "hallway";
@@ -67,7 +68,11 @@ TEST(ImportE2e, SimulatedHallwayRoundTripsThroughARosbag) {
   Simulate(so, kRoot / "sim");
   DatasetOptions no_gt;
   no_gt.load_groundtruth = false;
-  const Dataset sim = LoadDataset(kRoot / "sim", no_gt);
+  return LoadDataset(kRoot / "sim", no_gt);
+}
+
+TEST(ImportE2e, SimulatedHallwayRoundTripsThroughARosbag) {
+  const Dataset sim = SimulateHallway();
   ASSERT_TRUE(sim.base_from_cam.has_value());
 
   RosbagImportOptions o;
@@ -109,13 +114,12 @@ TEST(ImportE2e, SimulatedHallwayRoundTripsThroughARosbag) {
   EXPECT_LT(max_pose, 1e-6);
   EXPECT_LT(max_base, 1e-6);
   EXPECT_EQ(max_pixel, 0.0);
+  fs::remove_all(kRoot);
 }
 
 
 TEST(ImportE2e, CommandReportsAndFails) {
-  // Needs the bag of the round trip test (same executable, run in order).
-  const fs::path bag = kRoot / "hallway.bag";
-  ASSERT_TRUE(fs::exists(bag));
+  const fs::path bag = WriteBagOf(SimulateHallway());
   RunResult r = RunMonomap("import rosbag " + bag.string() + " -o " +
                            (kRoot / "cli").string() +
                            " --image-topic /camera/image_raw"
