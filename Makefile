@@ -10,7 +10,9 @@ DEMO_DIR ?= out/demo
 DEB_PACKAGES = cmake ninja-build g++ pkg-config libopencv-dev libeigen3-dev \
   libceres-dev libtbb-dev libyaml-cpp-dev nlohmann-json3-dev libcli11-dev \
   libtinygltf-dev libstb-dev libgtest-dev libgmock-dev libbenchmark-dev \
-  colmap help2man
+  colmap help2man \
+  librosbag-dev libsensor-msgs-dev libnav-msgs-dev libtf2-msgs-dev \
+  libgeometry-msgs-dev
 
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 

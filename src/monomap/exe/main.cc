@@ -70,6 +70,7 @@ int main(int argc, char** argv) {
   monomap::RegisterCalibrateCommand(app);
   monomap::RegisterDemoCommand(app);
   monomap::RegisterExportCommand(app);
+  monomap::RegisterImportCommand(app);
   if (!CheckSubcommandName(app, argc, argv)) return 2;
   try {
     app.parse(argc, argv);

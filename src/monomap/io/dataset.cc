@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 
+#include "monomap/io/camera_mount.h"
 #include "monomap/io/image_file.h"
 #include "monomap/io/trajectory_io.h"
 #include "monomap/util/error.h"
@@ -278,22 +279,8 @@ void WriteCameraYaml(const fs::path& path, const Camera& c,
 }
 
 Rigid3d ReadCameraMountYaml(const fs::path& path) {
-  return WithYamlErrors(path, [&] {
-    const YAML::Node root = LoadYaml(path);
-    if (!root.IsMap()) throw InputError(path.string() + ": not a YAML mapping");
-    const YAML::Node m = root["base_from_cam"];
-    if (!m) throw InputError(path.string(), "base_from_cam", "missing");
-    const auto t =
-        ReadNumbers(path, m["translation"], "base_from_cam.translation", 3);
-    const auto q =
-        ReadNumbers(path, m["rotation_xyzw"], "base_from_cam.rotation_xyzw", 4);
-    const Eigen::Quaterniond quat(q[3], q[0], q[1], q[2]);
-    if (std::abs(quat.norm() - 1.0) > 1e-2) {
-      throw InputError(path.string(), "base_from_cam.rotation_xyzw",
-                       "quaternion is not unit length");
-    }
-    return Rigid3d(quat.normalized(), Eigen::Vector3d(t[0], t[1], t[2]));
-  });
+  // All accepted forms (matrix, quaternion) live in camera_mount.cc.
+  return WithYamlErrors(path, [&] { return ReadCameraMount(path); });
 }
 
 void WriteCameraMountYaml(const fs::path& path, const Rigid3d& base_from_cam) {
