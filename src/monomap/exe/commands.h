@@ -14,6 +14,7 @@ void RegisterDemoCommand(CLI::App& app);
 void RegisterRenderCommand(CLI::App& app);
 void RegisterLocalizeCommand(CLI::App& app);
 void RegisterCalibrateCommand(CLI::App& app);
+void RegisterReportCommand(CLI::App& app);
 
 // --first-frame F and --frames N (the dataset frames a command uses), the
 // same for every subcommand that takes them.

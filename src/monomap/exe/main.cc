@@ -25,6 +25,7 @@ int main(int argc, char** argv) {
   monomap::RegisterLocalizeCommand(app);
   monomap::RegisterCalibrateCommand(app);
   monomap::RegisterDemoCommand(app);
+  monomap::RegisterReportCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
