@@ -34,6 +34,27 @@ std::string AssetOrThrow(std::string_view name) {
   return std::string(asset);
 }
 
+// The data without the embedded files (keys ending in "_base64"): the
+// JSON file is for reading figures, the page has the images.
+nlohmann::json WithoutBlobs(const nlohmann::json& data) {
+  if (data.is_array()) {
+    nlohmann::json out = nlohmann::json::array();
+    for (const nlohmann::json& v : data) out.push_back(WithoutBlobs(v));
+    return out;
+  }
+  if (!data.is_object()) return data;
+  nlohmann::json out = nlohmann::json::object();
+  for (const auto& [key, value] : data.items()) {
+    const std::string suffix = "_base64";
+    if (key.size() >= suffix.size() &&
+        key.compare(key.size() - suffix.size(), suffix.size(), suffix) == 0) {
+      continue;
+    }
+    out[key] = WithoutBlobs(value);
+  }
+  return out;
+}
+
 }  // namespace
 
 std::string RenderReportHtml(const nlohmann::json& data) {
@@ -85,7 +106,7 @@ std::vector<ReportProblem> WriteReport(const ReportInputs& inputs,
   }
   WriteReportHtml(html_path, data.json);
   if (!json_path.empty()) {
-    WriteFileAtomic(json_path, data.json.dump(1) + "\n");
+    WriteFileAtomic(json_path, WithoutBlobs(data.json).dump(1) + "\n");
   }
   return data.problems;
 }

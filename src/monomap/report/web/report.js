@@ -314,8 +314,8 @@
     if (box.isEmpty()) box.set(new THREE.Vector3(-1, -1, -1), new THREE.Vector3(1, 1, 1));
     const center = box.getCenter(new THREE.Vector3());
     const size = Math.max(box.getSize(new THREE.Vector3()).length(), 0.5);
-    camera.position.set(center.x - 0.35 * size, center.y - 0.75 * size,
-                        center.z + 0.6 * size);
+    camera.position.set(center.x - 0.3 * size, center.y - 0.6 * size,
+                        center.z + 0.45 * size);
     camera.near = size / 1000;
     camera.far = size * 100;
     camera.updateProjectionMatrix();
@@ -402,11 +402,9 @@
     group.add(cloud);
     group.add(truth);
     addLayer('particles', group);
-    const first = runs[0].particles.xyz[0];
-    for (let k = 0; k < first.length; k += 3) {
-      box.expandByPoint(new THREE.Vector3(first[k], first[k + 1], first[k + 2]));
-    }
-    truth.scale.setScalar(0.03 * Math.max(box.getSize(new THREE.Vector3()).length(), 0.5));
+    // The view stays framed on the map (a global start spreads the first
+    // particles over the whole area).
+    truth.scale.setScalar(0.01 * Math.max(box.getSize(new THREE.Vector3()).length(), 0.5));
 
     const select = document.getElementById('run-select');
     runs.forEach(function (r, i) { select.appendChild(el('option', { value: i, text: r.name })); });
