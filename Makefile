@@ -8,7 +8,8 @@ DEMO_DIR ?= out/demo
 # Debian 12 packages the build and the tests need.
 DEB_PACKAGES = cmake ninja-build g++ pkg-config libopencv-dev libeigen3-dev \
   libceres-dev libtbb-dev libyaml-cpp-dev nlohmann-json3-dev libcli11-dev \
-  libtinygltf-dev libstb-dev libgtest-dev libgmock-dev libbenchmark-dev
+  libtinygltf-dev libstb-dev libgtest-dev libgmock-dev libbenchmark-dev \
+  libjs-three libjs-chart.js
 
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 

@@ -23,7 +23,7 @@ struct RunResult {
   std::string output;  // stdout + stderr
 };
 
-RunResult Run(const std::string& args) {
+RunResult RunMonomap(const std::string& args) {
   const std::string cmd = std::string(MONOMAP_BINARY) + " " + args + " 2>&1";
   RunResult r;
   FILE* pipe = popen(cmd.c_str(), "r");
@@ -55,7 +55,7 @@ TEST(ReportE2eTest, BuildLocalizeAndReport) {
   const std::string data = (root / "data").string();
   const std::string map = (root / "map").string();
 
-  RunResult r = Run("build " + data + " -o " + map + " -q --html " +
+  RunResult r = RunMonomap("build " + data + " -o " + map + " -q --html " +
                     (root / "build.html").string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const std::string build_page = ReadFileToString(root / "build.html");
@@ -64,7 +64,7 @@ TEST(ReportE2eTest, BuildLocalizeAndReport) {
 
   const fs::path run = root / "run";
   fs::create_directories(run);
-  r = Run("localize " + map + " " + data + " --method mcl --particles 200 -o " +
+  r = RunMonomap("localize " + map + " " + data + " --method mcl --particles 200 -o " +
           (run / "trajectory.txt").string() + " --report " +
           (run / "report.json").string() + " --particles-out " +
           (run / "particles.csv").string() + " --html " +
@@ -73,7 +73,7 @@ TEST(ReportE2eTest, BuildLocalizeAndReport) {
   EXPECT_NE(ReadFileToString(root / "localize.html").find("\"particles\""),
             std::string::npos);
 
-  r = Run("report " + map + " --dataset " + data + " --localization " +
+  r = RunMonomap("report " + map + " --dataset " + data + " --localization " +
           run.string() + " -o " + (root / "report.html").string() +
           " --json " + (root / "report.json").string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
@@ -96,14 +96,14 @@ TEST(ReportE2eTest, BuildLocalizeAndReport) {
   fs::remove(root / "map" / "points.ply");
   fs::resize_file(root / "map" / "map.glb", 100);
   fs::remove(root / "report.html");
-  r = Run("report " + map + " -o " + (root / "report.html").string());
+  r = RunMonomap("report " + map + " -o " + (root / "report.html").string());
   EXPECT_EQ(r.exit_code, 1) << r.output;
   EXPECT_NE(r.output.find("points.ply: missing"), std::string::npos)
       << r.output;
   EXPECT_NE(r.output.find("map.glb: truncated"), std::string::npos)
       << r.output;
   const std::string page = ReadFileToString(root / "report.html");
-  EXPECT_NE(page.find("points.ply\",\"message\":\"missing"),
+  EXPECT_NE(page.find("points.ply\",\"message\":\"missing\"}"),
             std::string::npos);
   fs::remove_all(root);
 }
