@@ -21,30 +21,11 @@
 #include "monomap/io/map_format.h"
 #include "monomap/io/trajectory_io.h"
 #include "monomap/sim/simulate.h"
+#include "run_monomap.h"
 
 namespace monomap {
 namespace {
 namespace fs = std::filesystem;
-
-struct RunResult {
-  int exit_code = -1;
-  std::string output;  // stdout + stderr
-};
-
-RunResult RunMonomap(const std::string& args) {
-  const std::string cmd = std::string(MONOMAP_BINARY) + " " + args + " 2>&1";
-  RunResult r;
-  FILE* pipe = popen(cmd.c_str(), "r");
-  if (!pipe) return r;
-  std::array<char, 4096> buf;
-  size_t n;
-  while ((n = fread(buf.data(), 1, buf.size(), pipe)) > 0) {
-    r.output.append(buf.data(), n);
-  }
-  const int status = pclose(pipe);
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
 
 class Cli : public ::testing::Test {
  protected:

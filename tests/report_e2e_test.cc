@@ -13,30 +13,11 @@
 
 #include "monomap/sim/simulate.h"
 #include "monomap/util/file.h"
+#include "run_monomap.h"
 
 namespace monomap {
 namespace {
 namespace fs = std::filesystem;
-
-struct RunResult {
-  int exit_code = -1;
-  std::string output;  // stdout + stderr
-};
-
-RunResult RunMonomap(const std::string& args) {
-  const std::string cmd = std::string(MONOMAP_BINARY) + " " + args + " 2>&1";
-  RunResult r;
-  FILE* pipe = popen(cmd.c_str(), "r");
-  if (!pipe) return r;
-  std::array<char, 4096> buf;
-  size_t n;
-  while ((n = fread(buf.data(), 1, buf.size(), pipe)) > 0) {
-    r.output.append(buf.data(), n);
-  }
-  const int status = pclose(pipe);
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
 
 nlohmann::json ReadJson(const fs::path& path) {
   return nlohmann::json::parse(ReadFileToString(path));
@@ -56,7 +37,7 @@ TEST(ReportE2eTest, BuildLocalizeAndReport) {
   const std::string map = (root / "map").string();
 
   RunResult r = RunMonomap("build " + data + " -o " + map + " -q --html " +
-                    (root / "build.html").string());
+                           (root / "build.html").string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const std::string build_page = ReadFileToString(root / "build.html");
   EXPECT_GT(build_page.size(), 1000000u);  // three.js and Chart.js inlined
@@ -64,18 +45,19 @@ TEST(ReportE2eTest, BuildLocalizeAndReport) {
 
   const fs::path run = root / "run";
   fs::create_directories(run);
-  r = RunMonomap("localize " + map + " " + data + " --method mcl --particles 200 -o " +
-          (run / "trajectory.txt").string() + " --report " +
-          (run / "report.json").string() + " --particles-out " +
-          (run / "particles.csv").string() + " --html " +
-          (root / "localize.html").string());
+  r = RunMonomap("localize " + map + " " + data +
+                 " --method mcl --particles 200 -o " +
+                 (run / "trajectory.txt").string() + " --report " +
+                 (run / "report.json").string() + " --particles-out " +
+                 (run / "particles.csv").string() + " --html " +
+                 (root / "localize.html").string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(ReadFileToString(root / "localize.html").find("\"particles\""),
             std::string::npos);
 
   r = RunMonomap("report " + map + " --dataset " + data + " --localization " +
-          run.string() + " -o " + (root / "report.html").string() +
-          " --json " + (root / "report.json").string());
+                 run.string() + " -o " + (root / "report.html").string() +
+                 " --json " + (root / "report.json").string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const nlohmann::json j = ReadJson(root / "report.json");
   EXPECT_EQ(j["problems"].size(), 0u);
@@ -88,9 +70,9 @@ TEST(ReportE2eTest, BuildLocalizeAndReport) {
   EXPECT_EQ(j["localization"][0]["xyz"].size(), 3u * 40);
   EXPECT_EQ(j["localization"][0]["particles"]["steps"].size(), 40u);
   EXPECT_EQ(j["localization"][0]["report"]["steps"].size(), 40u);
-  EXPECT_NE(j["provenance"]["command_line"].get<std::string>().find(
-                "report " + map),
-            std::string::npos);
+  EXPECT_NE(
+      j["provenance"]["command_line"].get<std::string>().find("report " + map),
+      std::string::npos);
 
   // A broken map directory: named, exit status 1, the page still written.
   fs::remove(root / "map" / "points.ply");
@@ -100,8 +82,7 @@ TEST(ReportE2eTest, BuildLocalizeAndReport) {
   EXPECT_EQ(r.exit_code, 1) << r.output;
   EXPECT_NE(r.output.find("points.ply: missing"), std::string::npos)
       << r.output;
-  EXPECT_NE(r.output.find("map.glb: truncated"), std::string::npos)
-      << r.output;
+  EXPECT_NE(r.output.find("map.glb: truncated"), std::string::npos) << r.output;
   const std::string page = ReadFileToString(root / "report.html");
   EXPECT_NE(page.find("points.ply\",\"message\":\"missing\"}"),
             std::string::npos);

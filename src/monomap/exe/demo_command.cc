@@ -14,8 +14,7 @@ namespace {
 
 // The report page of the demo: the map and its dataset, the two
 // localization runs, and the evaluation's figures.
-std::filesystem::path WriteDemoPage(const DemoReport& r,
-                                    const DemoOptions& o) {
+std::filesystem::path WriteDemoPage(const DemoReport& r, const DemoOptions& o) {
   ReportInputs in;
   in.map_dir = r.map_dir;
   in.dataset_dir = r.dataset_dir;

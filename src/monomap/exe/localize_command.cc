@@ -127,11 +127,9 @@ void RegisterLocalizeCommand(CLI::App& app) {
     options.seed = a->seed;
     std::vector<TimedPose> trajectory;
     std::vector<std::vector<Particle>> sets;
-    const LocalizationReport r =
-        LocalizeSequence(map, dataset, options, &trajectory,
-                         a->particles_out.empty() && a->html.empty()
-                             ? nullptr
-                             : &sets);
+    const LocalizationReport r = LocalizeSequence(
+        map, dataset, options, &trajectory,
+        a->particles_out.empty() && a->html.empty() ? nullptr : &sets);
     WriteTumTrajectory(a->output, trajectory,
                        "monomap localize --method " + a->method);
     if (!a->particles_out.empty()) {

@@ -18,8 +18,9 @@ void RegisterReportCommand(CLI::App& app) {
   };
   auto a = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
-      "report", "Write a self-contained HTML report of a map (3D view, "
-                "trajectory, errors, textures, tracked features)");
+      "report",
+      "Write a self-contained HTML report of a map (3D view, "
+      "trajectory, errors, textures, tracked features)");
   cmd->add_option("map", a->map_dir, "Map directory")->required();
   cmd->add_option("-o,--output", a->output, "HTML page to write")->required();
   cmd->add_option("--dataset", a->dataset,

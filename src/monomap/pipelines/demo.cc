@@ -66,8 +66,8 @@ Rigid3d EvaluateDemoMap(const Map& map, const DemoDataset& d,
       EvaluateStructure(map, truth, world_from_map.rigid, options.structure);
   report->ate_refined = AbsoluteTrajectoryError(map.trajectory, d.groundtruth,
                                                 Alignment::kFirstPose);
-  report->ate_odometry = AbsoluteTrajectoryError(d.odometry, d.groundtruth,
-                                                 Alignment::kFirstPose);
+  report->ate_odometry =
+      AbsoluteTrajectoryError(d.odometry, d.groundtruth, Alignment::kFirstPose);
   const int delta =
       std::min(options.rpe_delta_frames, std::max(1, report->frames - 1));
   report->rpe_refined = RelativePoseError(map.trajectory, d.groundtruth, delta);
@@ -157,9 +157,9 @@ DemoReport RunDemo(const DemoOptions& options) {
 
   if (options.localization.enabled) {
     say("localizing a second traversal (MCL and MCC, global start)");
-    report.localization = RunDemoLocalization(
-        result.map, sim, world_from_map.Inverse(), options.localization,
-        dir / "localization_dataset");
+    report.localization =
+        RunDemoLocalization(result.map, sim, world_from_map.Inverse(),
+                            options.localization, dir / "localization_dataset");
   }
   report.total_seconds = total_timer.ElapsedSeconds();
   WriteFileAtomic(report.report_json, report.ToJson().dump(2) + "\n");

@@ -27,13 +27,12 @@ void WriteReportHtml(const std::filesystem::path& path,
                      const nlohmann::json& data);
 
 // Gathers the report, writes the page and (if json_path is not empty) the
-// data as JSON, and returns the problems found in the inputs. The page is
+// data as JSON without the embedded files (keys *_base64), and returns the problems found in the inputs. The page is
 // written even if there are problems.
-std::vector<ReportProblem> WriteReport(const ReportInputs& inputs,
-                                       const std::filesystem::path& html_path,
-                                       const std::filesystem::path& json_path =
-                                           {},
-                                       const ReportOptions& options = {});
+std::vector<ReportProblem> WriteReport(
+    const ReportInputs& inputs, const std::filesystem::path& html_path,
+    const std::filesystem::path& json_path = {},
+    const ReportOptions& options = {});
 
 // What exe/ reports after WriteReport found problems: throws InputError
 // naming the files (exit status 1), or returns if there are none.

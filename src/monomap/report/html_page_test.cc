@@ -65,8 +65,7 @@ TEST(HtmlPageTest, WriteReportWritesThePageEvenForAMissingMap) {
   std::filesystem::create_directories(dir);
   ReportInputs in;
   in.map_dir = dir / "no_such_map";
-  const auto problems =
-      WriteReport(in, dir / "r.html", dir / "r.json");
+  const auto problems = WriteReport(in, dir / "r.html", dir / "r.json");
   EXPECT_EQ(problems.size(), 4u);  // map.json, points, trajectory, glb
   const std::string html = ReadFileToString(dir / "r.html");
   EXPECT_NE(html.find("no_such_map/map.json"), std::string::npos);

@@ -72,8 +72,8 @@ LocalizationRunData ReadLocalizationRun(const std::string& spec,
     run.name = std::filesystem::path(spec).lexically_normal().filename();
     if (run.name.empty()) run.name = dir.parent_path().filename();
     trajectory = dir / "trajectory.txt";
-    for (const char* name : {"report.json", "particles.csv",
-                             "groundtruth.txt"}) {
+    for (const char* name :
+         {"report.json", "particles.csv", "groundtruth.txt"}) {
       if (!std::filesystem::exists(dir / name)) continue;
       const std::string n = name;
       (n == "report.json"     ? report

@@ -28,16 +28,16 @@
 namespace monomap {
 
 void ReportOptions::Check() const {
-  auto positive = [](int v, const char* name) {
-    if (v < 1) throw OptionsError(std::string("report: ") + name + " < 1");
-  };
-  positive(max_points, "max_points");
-  positive(max_texture_width, "max_texture_width");
-  positive(overlay_width, "overlay_width");
-  positive(overlay_tail, "overlay_tail");
-  positive(max_particles_per_step, "max_particles_per_step");
-  positive(max_particle_steps, "max_particle_steps");
-  if (overlay_frames < 0) throw OptionsError("report: overlay_frames < 0");
+  CheckOption(max_points >= 1, "report.max_points", "must be >= 1");
+  CheckOption(max_texture_width >= 1, "report.max_texture_width",
+              "must be >= 1");
+  CheckOption(overlay_frames >= 0, "report.overlay_frames", "must be >= 0");
+  CheckOption(overlay_width >= 1, "report.overlay_width", "must be >= 1");
+  CheckOption(overlay_tail >= 1, "report.overlay_tail", "must be >= 1");
+  CheckOption(max_particles_per_step >= 1, "report.max_particles_per_step",
+              "must be >= 1");
+  CheckOption(max_particle_steps >= 1, "report.max_particle_steps",
+              "must be >= 1");
 }
 
 std::string Base64Encode(const std::string& bytes) {
@@ -196,9 +196,8 @@ void CheckGlb(const std::string& bytes) {
 
 MapPieces ReadMapPieces(const std::filesystem::path& dir, MapFiles* files) {
   MapPieces m;
-  files->Read(kMapTrajectoryFile, true, [&](const auto& p) {
-    m.trajectory = ReadTumTrajectory(p);
-  });
+  files->Read(kMapTrajectoryFile, true,
+              [&](const auto& p) { m.trajectory = ReadTumTrajectory(p); });
   files->Read(kMapPointsFile, true,
               [&](const auto& p) { m.landmarks = ReadLandmarksPly(p); });
   files->Read(kMapGlbFile, true, [&](const auto& p) {
@@ -251,32 +250,33 @@ nlohmann::json PlanesJson(const Map& map,
                           const ReportOptions& options) {
   nlohmann::json planes = nlohmann::json::array();
   for (const TexturedPlane& p : map.planes) {
-    const auto points = std::count_if(
-        landmarks.begin(), landmarks.end(),
-        [&](const Landmark& l) { return l.plane_id == p.id; });
+    const auto points =
+        std::count_if(landmarks.begin(), landmarks.end(),
+                      [&](const Landmark& l) { return l.plane_id == p.id; });
     cv::Mat tex = p.texture;
     if (!tex.empty() && tex.cols > options.max_texture_width) {
-      const double s = static_cast<double>(options.max_texture_width) / tex.cols;
+      const double s =
+          static_cast<double>(options.max_texture_width) / tex.cols;
       cv::resize(tex, tex,
                  cv::Size(options.max_texture_width,
                           std::max(1, cvRound(tex.rows * s))),
                  0, 0, cv::INTER_AREA);
     }
-    planes.push_back({{"id", p.id},
-                      {"width", p.texture.cols},
-                      {"height", p.texture.rows},
-                      {"pixels_per_meter", Round3(p.pixels_per_meter)},
-                      {"coverage", Round3(TextureCoverage(p))},
-                      {"points", points},
-                      {"png_base64", tex.empty() ? "" : EncodeImage(tex, ".png")}});
+    planes.push_back(
+        {{"id", p.id},
+         {"width", p.texture.cols},
+         {"height", p.texture.rows},
+         {"pixels_per_meter", Round3(p.pixels_per_meter)},
+         {"coverage", Round3(TextureCoverage(p))},
+         {"points", points},
+         {"png_base64", tex.empty() ? "" : EncodeImage(tex, ".png")}});
   }
   return planes;
 }
 
 nlohmann::json PointsJson(const std::vector<Landmark>& landmarks,
                           const ReportOptions& options) {
-  nlohmann::json xyz = nlohmann::json::array(),
-                 plane = nlohmann::json::array();
+  nlohmann::json xyz = nlohmann::json::array(), plane = nlohmann::json::array();
   const size_t stride = std::max<size_t>(
       1, (landmarks.size() + options.max_points - 1) / options.max_points);
   for (size_t i = 0; i < landmarks.size(); i += stride) {
@@ -370,11 +370,10 @@ void AddDatasetFigures(const Dataset& d, const MapPieces& m,
       Transformed(map_from_world * gt_from_odometry, odometry);
   trajectories.push_back(TrajectoryJson("odometry", odometry_in_map));
   trajectories.push_back(TrajectoryJson("ground truth", gt_in_map));
-  (*j)["errors"] = {
-      {"alignment", "first pose"},
-      {"series",
-       {ErrorSeries("map (refined)", m.trajectory, gt_in_map),
-        ErrorSeries("odometry", odometry_in_map, gt_in_map)}}};
+  (*j)["errors"] = {{"alignment", "first pose"},
+                    {"series",
+                     {ErrorSeries("map (refined)", m.trajectory, gt_in_map),
+                      ErrorSeries("odometry", odometry_in_map, gt_in_map)}}};
 }
 
 nlohmann::json LocalizationJson(const LocalizationRunData& run,
@@ -386,8 +385,7 @@ nlohmann::json LocalizationJson(const LocalizationRunData& run,
     j["groundtruth"] = TrajectoryJson("ground truth", run.groundtruth);
     j["error"] = ErrorSeries(run.name, run.trajectory, run.groundtruth);
   }
-  nlohmann::json steps = nlohmann::json::array(),
-                 xyz = nlohmann::json::array();
+  nlohmann::json steps = nlohmann::json::array(), xyz = nlohmann::json::array();
   const size_t n = run.particles.size();
   const size_t stride = std::max<size_t>(
       1, (n + options.max_particle_steps - 1) / options.max_particle_steps);

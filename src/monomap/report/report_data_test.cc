@@ -14,6 +14,7 @@
 #include "monomap/io/trajectory_io.h"
 #include "monomap/report/localization_run.h"
 #include "monomap/sim/simulate.h"
+#include "monomap/util/error.h"
 #include "monomap/util/file.h"
 
 namespace monomap {
@@ -27,6 +28,18 @@ TEST(Base64Test, Rfc4648Vectors) {
   EXPECT_EQ(Base64Encode("foo"), "Zm9v");
   EXPECT_EQ(Base64Encode("foobar"), "Zm9vYmFy");
   EXPECT_EQ(Base64Encode(std::string("\xff\x00\x10", 3)), "/wAQ");
+}
+
+TEST(ReportOptionsTest, RejectsBadValues) {
+  ReportOptions o;
+  EXPECT_NO_THROW(o.Check());
+  o.max_points = 0;
+  EXPECT_THROW(o.Check(), OptionsError);
+  o = ReportOptions();
+  o.overlay_frames = -1;
+  EXPECT_THROW(o.Check(), OptionsError);
+  o.overlay_frames = 0;  // no overlays is fine
+  EXPECT_NO_THROW(o.Check());
 }
 
 // A simulated dataset and a map "built" from it by hand, with figures
@@ -115,8 +128,7 @@ TEST_F(ReportDataTest, FiguresOfACompleteMap) {
   // map.glb is embedded whole ("glTF" magic = "Z2xURg" in base64).
   EXPECT_EQ(j["glb_base64"].get<std::string>().rfind("Z2xURg", 0), 0u);
   const auto glb_bytes = fs::file_size(in.map_dir / "map.glb");
-  EXPECT_EQ(j["glb_base64"].get<std::string>().size(),
-            (glb_bytes + 2) / 3 * 4);
+  EXPECT_EQ(j["glb_base64"].get<std::string>().size(), (glb_bytes + 2) / 3 * 4);
 
   ASSERT_EQ(j["planes"].size(), 1u);
   const nlohmann::json& p = j["planes"][0];
@@ -152,7 +164,7 @@ TEST_F(ReportDataTest, FiguresOfACompleteMap) {
   EXPECT_EQ(f["frame"], 10);
   EXPECT_EQ(f["width"], 160);
   ASSERT_EQ(f["tracks"].size(), 2u);
-  EXPECT_EQ(f["tracks"][0].size(), 2u * 11);  // frames 0..10
+  EXPECT_EQ(f["tracks"][0].size(), 2u * 11);                 // frames 0..10
   EXPECT_DOUBLE_EQ(f["tracks"][0][20].get<double>(), 20.0);  // u at frame 10
   EXPECT_EQ(j["summary"]["tracks"], 2);
   EXPECT_EQ(j["summary"]["frames"], 20);
@@ -192,7 +204,9 @@ TEST_F(ReportDataTest, CorruptTrajectoryNamesFileAndLine) {
   const ReportData r = BuildReportData(in);
   ASSERT_GE(r.problems.size(), 1u);
   EXPECT_EQ(r.problems[0].file, (dir / "trajectory.txt").string());
-  EXPECT_NE(r.problems[0].message.find("trajectory.txt:" + std::to_string(bad_line) + ":"), std::string::npos)
+  EXPECT_NE(r.problems[0].message.find(
+                "trajectory.txt:" + std::to_string(bad_line) + ":"),
+            std::string::npos)
       << r.problems[0].message;
 }
 
@@ -241,9 +255,10 @@ TEST_F(ReportDataTest, LocalizationRunFromItsFiles) {
   WriteFileAtomic(run / "particles.csv",
                   "step,x,y,z,qx,qy,qz,qw,log_weight\n0,1,2,x,0,0,0,1,-1\n");
   problems.clear();
-  const LocalizationRunData bad = ReadLocalizationRun(
-      (run / "trajectory.txt").string() + "," + (run / "particles.csv").string(),
-      &problems);
+  const LocalizationRunData bad =
+      ReadLocalizationRun((run / "trajectory.txt").string() + "," +
+                              (run / "particles.csv").string(),
+                          &problems);
   ASSERT_EQ(problems.size(), 1u);
   EXPECT_NE(problems[0].message.find("particles.csv:2"), std::string::npos)
       << problems[0].message;
