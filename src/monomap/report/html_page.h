@@ -27,8 +27,9 @@ void WriteReportHtml(const std::filesystem::path& path,
                      const nlohmann::json& data);
 
 // Gathers the report, writes the page and (if json_path is not empty) the
-// data as JSON without the embedded files (keys *_base64), and returns the problems found in the inputs. The page is
-// written even if there are problems.
+// data as JSON without the embedded files (keys *_base64), and returns the
+// problems found in the inputs. The page is written even if there are
+// problems.
 std::vector<ReportProblem> WriteReport(
     const ReportInputs& inputs, const std::filesystem::path& html_path,
     const std::filesystem::path& json_path = {},
