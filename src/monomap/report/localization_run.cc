@@ -98,8 +98,12 @@ LocalizationRunData ReadLocalizationRun(const std::string& spec,
     }
     run.name = trajectory.stem().string();
   }
-  ReadPart(trajectory, &run, problems,
-           [&](const auto& p) { run.trajectory = ReadTumTrajectory(p); });
+  if (trajectory.empty()) {
+    problems->push_back({spec, "no trajectory (.txt) among the files"});
+  } else {
+    ReadPart(trajectory, &run, problems,
+             [&](const auto& p) { run.trajectory = ReadTumTrajectory(p); });
+  }
   if (!report.empty()) {
     ReadPart(report, &run, problems, [&](const auto& p) {
       run.report = nlohmann::json::parse(ReadFileToString(p));
