@@ -77,9 +77,12 @@ TEST(DemoReportTest, SmallHallwayDemo) {
     EXPECT_EQ(run.report.frames, 30) << run.name;
     EXPECT_EQ(run.accuracy.matched, 30) << run.name;
     EXPECT_EQ(run.particles.size(), 30u) << run.name;
-    EXPECT_EQ(run.particles.front().size(),
-              static_cast<size_t>(o.localization.plotted_particles))
-        << run.name;
+    for (const auto& set : run.particles) {  // a subset of each set
+      EXPECT_GT(set.size(), 0u) << run.name;
+      EXPECT_LE(set.size(),
+                static_cast<size_t>(o.localization.plotted_particles))
+          << run.name;
+    }
   }
   std::printf(
       "texture fidelity NCC %.3f, PSNR %.1f dB; MCL final %.3f m, "
@@ -94,9 +97,9 @@ TEST(DemoReportTest, SmallHallwayDemo) {
       nlohmann::json::parse(ReadFileToString(r.report_json));
   EXPECT_EQ(figures["counts"]["frames"], 60);
   EXPECT_EQ(figures["localization"]["runs"].size(), 2u);
-  EXPECT_DOUBLE_EQ(
-      figures["trajectory"]["ate_refined"]["translation_m"]["rms"].get<double>(),
-      r.ate_refined.translation_m.rms);
+  EXPECT_DOUBLE_EQ(figures["trajectory"]["ate_refined"]["translation_m"]["rms"]
+                       .get<double>(),
+                   r.ate_refined.translation_m.rms);
   std::filesystem::remove_all(dir);
 }
 
