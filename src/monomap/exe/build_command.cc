@@ -6,6 +6,7 @@
 #include "monomap/exe/commands.h"
 #include "monomap/io/dataset.h"
 #include "monomap/pipelines/mapping_pipeline.h"
+#include "monomap/report/html_page.h"
 #include "monomap/util/file.h"
 
 namespace monomap {
@@ -15,6 +16,7 @@ void RegisterBuildCommand(CLI::App& app) {
     std::string dataset;
     std::string output;
     std::string report;
+    std::string html;
     std::string camera_yaml;
     int first_frame = 0;
     int num_frames = -1;
@@ -41,6 +43,8 @@ void RegisterBuildCommand(CLI::App& app) {
       ->required();
   cmd->add_option("--report", args->report,
                   "Write counts and per-stage timings as JSON");
+  cmd->add_option("--html", args->html,
+                  "Also write the map's HTML report (see 'monomap report')");
   cmd->add_option("--camera", args->camera_yaml,
                   "Calibration to use instead of DATASET/camera.yaml (e.g. "
                   "from 'monomap calibrate')");
@@ -150,6 +154,13 @@ void RegisterBuildCommand(CLI::App& app) {
     const nlohmann::json report = result.report.ToJson();
     if (!args->report.empty()) {
       WriteFileAtomic(args->report, report.dump(2) + "\n");
+    }
+    if (!args->html.empty()) {
+      ReportInputs in;
+      in.map_dir = args->output;
+      in.dataset_dir = args->dataset;
+      in.command_line = CurrentCommandLine();
+      ThrowIfProblems(WriteReport(in, args->html), args->html);
     }
     if (!args->quiet) {
       std::fprintf(stderr,

@@ -16,6 +16,7 @@ void RegisterLocalizeCommand(CLI::App& app);
 void RegisterCalibrateCommand(CLI::App& app);
 void RegisterExportCommand(CLI::App& app);
 void RegisterImportCommand(CLI::App& app);
+void RegisterReportCommand(CLI::App& app);
 
 // --first-frame F and --frames N (the dataset frames a command uses), the
 // same for every subcommand that takes them.

@@ -12,6 +12,8 @@
 #include "monomap/io/map_format.h"
 #include "monomap/io/trajectory_io.h"
 #include "monomap/localization/localizer.h"
+#include "monomap/report/html_page.h"
+#include "monomap/report/localization_run.h"
 #include "monomap/util/error.h"
 #include "monomap/util/file.h"
 
@@ -20,6 +22,7 @@ namespace monomap {
 void RegisterLocalizeCommand(CLI::App& app) {
   struct Args {
     std::string map_dir, dataset, output, report, particles_out, camera_yaml;
+    std::string html;
     std::string init_pose;
     std::string method = "mcl", init = "pose", state = "planar";
     int particles = 1000;
@@ -74,6 +77,10 @@ void RegisterLocalizeCommand(CLI::App& app) {
       "--particles-out", a->particles_out,
       "Write the particle sets per step (CSV: step, camera position, "
       "orientation quaternion, log weight)");
+  cmd->add_option("--html", a->html,
+                  "Also write an HTML report of the run in the map (3D view "
+                  "with the particles, errors if the dataset has ground "
+                  "truth)");
   cmd->callback([a]() {
     CheckOutputFile(a->output, {a->map_dir, a->dataset});
     const Map map = ReadMap(a->map_dir);
@@ -121,9 +128,9 @@ void RegisterLocalizeCommand(CLI::App& app) {
     options.seed = a->seed;
     std::vector<TimedPose> trajectory;
     std::vector<std::vector<Particle>> sets;
-    const LocalizationReport r =
-        LocalizeSequence(map, dataset, options, &trajectory,
-                         a->particles_out.empty() ? nullptr : &sets);
+    const LocalizationReport r = LocalizeSequence(
+        map, dataset, options, &trajectory,
+        a->particles_out.empty() && a->html.empty() ? nullptr : &sets);
     WriteTumTrajectory(a->output, trajectory,
                        "monomap localize --method " + a->method);
     if (!a->particles_out.empty()) {
@@ -174,6 +181,27 @@ void RegisterLocalizeCommand(CLI::App& app) {
     }
     j["steps"] = steps;
     if (!a->report.empty()) WriteFileAtomic(a->report, j.dump(2) + "\n");
+    if (!a->html.empty()) {
+      // The run as `monomap report --localization` would read it back.
+      ReportInputs in;
+      in.map_dir = a->map_dir;
+      in.command_line = CurrentCommandLine();
+      LocalizationRunData run;
+      run.name = a->method;
+      run.sources = {a->output};
+      run.trajectory = trajectory;
+      for (const DatasetFrame& f : dataset.frames) {
+        if (f.groundtruth_world_from_cam) {
+          run.groundtruth.push_back(
+              {f.timestamp, *f.groundtruth_world_from_cam});
+        }
+      }
+      run.particles =
+          ParticlePositions(sets, ReportOptions().max_particles_per_step);
+      run.report = j;
+      in.localization.push_back(std::move(run));
+      ThrowIfProblems(WriteReport(in, a->html), a->html);
+    }
     std::fprintf(stderr, "monomap: localized %d frames in %.1f s", r.frames,
                  r.seconds);
     if (r.has_errors) {

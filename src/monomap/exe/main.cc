@@ -71,6 +71,7 @@ int main(int argc, char** argv) {
   monomap::RegisterDemoCommand(app);
   monomap::RegisterExportCommand(app);
   monomap::RegisterImportCommand(app);
+  monomap::RegisterReportCommand(app);
   if (!CheckSubcommandName(app, argc, argv)) return 2;
   try {
     app.parse(argc, argv);

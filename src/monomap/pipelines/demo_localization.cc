@@ -114,12 +114,12 @@ DemoLocalization RunDemoLocalization(const Map& map,
         std::shuffle(set.begin(), set.end(), rng);
         set.resize(options.plotted_particles);
       }
-      std::vector<Eigen::Vector2d> xy;
-      xy.reserve(set.size());
+      std::vector<Eigen::Vector3d> xyz;
+      xyz.reserve(set.size());
       for (const Particle& p : set) {
-        xy.emplace_back(p.world_from_cam.translation.head<2>());
+        xyz.push_back(p.world_from_cam.translation);
       }
-      run.particles_xy.push_back(std::move(xy));
+      run.particles.push_back(std::move(xyz));
     }
     out.runs.push_back(std::move(run));
   }

@@ -38,8 +38,8 @@ struct DemoLocalizationOptions {
   // particles over the whole hallway often lock onto one of them (see the
   // 20-seed figures in docs/benchmarks.md), 3000 cover it densely enough.
   int particles = 3000;
-  // Particles drawn per plotted step (a random subset keeps the page
-  // small).
+  // Particles kept per step for the report (a random subset keeps the
+  // page small).
   int plotted_particles = 400;
   // Every n-th frame of the traversal is rendered for texture fidelity.
   int fidelity_stride = 5;
@@ -57,8 +57,8 @@ struct DemoLocalizationRun {
   LocalizationAccuracy accuracy;
   // The estimate per step (map frame).
   std::vector<TimedPose> trajectory;
-  // Camera x, y of a subset of the particles after each step.
-  std::vector<std::vector<Eigen::Vector2d>> particles_xy;
+  // Camera positions of a subset of the particles after each step.
+  std::vector<std::vector<Eigen::Vector3d>> particles;
 
   nlohmann::json ToJson() const;
 };

@@ -1,14 +1,14 @@
 // The end-to-end demo: simulate a world, build its map, evaluate the map
-// against the simulator's exact ground truth and write a self-contained
-// HTML report (DIR/report.html, images embedded, no external resources)
-// plus all figures as JSON (DIR/report.json).
+// against the simulator's exact ground truth, localize a second traversal
+// in it, and write all figures as JSON (DIR/report.json). The HTML page
+// is the report module's (exe/demo_command.cc writes DIR/report.html from
+// the map, the dataset and this report).
 //
 // Output directory layout:
 //   DIR/dataset/      the simulated dataset (with structure/ = true planes)
 //   DIR/map/          the built map (see io/map_format.h)
 //   DIR/localization_dataset/  a second traversal, localized in the map
-//   DIR/report.html   the report
-//   DIR/report.json   every figure of the report
+//   DIR/report.json  every figure of the evaluation
 #pragma once
 
 #include <cstdint>
@@ -50,7 +50,6 @@ struct DemoOptions {
 };
 
 struct DemoReport {
-  std::filesystem::path report_html;
   std::filesystem::path report_json;
   std::filesystem::path dataset_dir;
   std::filesystem::path map_dir;
@@ -77,7 +76,6 @@ struct DemoReport {
   double simulate_seconds = 0.0;
   double mapping_seconds = 0.0;
   double evaluation_seconds = 0.0;
-  double report_seconds = 0.0;
   double total_seconds = 0.0;
 
   // Every figure above (what report.json holds).
