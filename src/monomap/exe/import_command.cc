@@ -14,6 +14,7 @@
 #include "monomap/exe/commands.h"
 #include "monomap/io/standard_import.h"
 #include "monomap/util/error.h"
+#include "monomap/util/file.h"
 #ifdef MONOMAP_HAVE_ROSBAG
 #include "monomap/io/rosbag_import.h"
 #endif
@@ -64,6 +65,7 @@ void RegisterRosbagImport(CLI::App* import) {
     if (o->odom_topic.empty() && o->odom_tf.empty()) {
       throw OptionsError("import rosbag: give --odom-topic or --odom-tf");
     }
+    CheckOutputDirectory(*out, "dataset", {*bag});
     const RosbagImportReport r = ImportRosbag(*bag, *out, *o);
     if (*quiet) return;
     std::fprintf(stderr,
@@ -149,6 +151,7 @@ void RegisterTumImport(CLI::App* import) {
   AddPosedImageOptions(cmd, &o->odometry, &o->simulated, &o->max_pose_gap);
   cmd->add_flag("-q,--quiet", *quiet, "No summary");
   cmd->callback([o, dir, out, quiet]() {
+    CheckOutputDirectory(*out, "dataset", {*dir});
     const ImportReport r = ImportTum(*dir, *out, *o);
     if (!*quiet) PrintImportReport(*dir, *out, r);
   });
@@ -170,6 +173,7 @@ void RegisterEurocImport(CLI::App* import) {
   AddPosedImageOptions(cmd, &o->odometry, &o->simulated, &o->max_pose_gap);
   cmd->add_flag("-q,--quiet", *quiet, "No summary");
   cmd->callback([o, dir, out, quiet]() {
+    CheckOutputDirectory(*out, "dataset", {*dir});
     const ImportReport r = ImportEuroc(*dir, *out, *o);
     if (!*quiet) PrintImportReport(*dir, *out, r);
   });
@@ -193,6 +197,7 @@ void RegisterKittiImport(CLI::App* import) {
   AddPosedImageOptions(cmd, &o->odometry, &o->simulated, &o->max_pose_gap);
   cmd->add_flag("-q,--quiet", *quiet, "No summary");
   cmd->callback([o, dir, out, quiet]() {
+    CheckOutputDirectory(*out, "dataset", {*dir});
     const ImportReport r = ImportKitti(*dir, *out, *o);
     if (!*quiet) PrintImportReport(*dir, *out, r);
   });
@@ -222,6 +227,7 @@ void RegisterVideoImport(CLI::App* import) {
       ->capture_default_str();
   cmd->add_flag("-q,--quiet", *quiet, "No summary");
   cmd->callback([o, video, out, quiet]() {
+    CheckOutputDirectory(*out, "dataset", {*video});
     const ImportReport r = ImportVideo(*video, *out, *o);
     if (!*quiet) PrintImportReport(*video, *out, r);
   });

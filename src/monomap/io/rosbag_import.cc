@@ -467,7 +467,7 @@ RosbagImportReport ImportRosbag(const fs::path& bag_path,
   if (!fs::is_regular_file(bag_path)) {
     throw InputError(bag_path.string() + ": bag file not found");
   }
-  AtomicDirectory out(out_dir);
+  AtomicDirectory out(out_dir, "dataset");
   ImportState s{options, bag_path.string(), {}, {}, {}, out.path(), {}, {}};
   try {
     rosbag::Bag bag;

@@ -180,7 +180,7 @@ ImportReport ImportPosedImages(const PosedImages& in, const Camera& camera,
   report.images_listed = static_cast<int>(in.images.size());
   report.odometry_simulated = simulate;
   report.camera = camera;
-  AtomicDirectory out(out_dir);
+  AtomicDirectory out(out_dir, "dataset");
   std::vector<ImportedFrame> frames;
   std::vector<Rigid3d> poses;
   for (const TumImage& im : in.images) {
@@ -500,7 +500,7 @@ ImportReport ImportVideo(const fs::path& video, const fs::path& out_dir,
   // return), from which ImportPosedImages hard-links them.
   fs::path base = out_dir;
   if (!base.has_filename()) base = base.parent_path();  // "DIR/"
-  AtomicDirectory frames(base.string() + ".frames");
+  AtomicDirectory frames(base.string() + ".frames", "scratch");
   PosedImages in;
   in.root = frames.path();
   in.list = video;
