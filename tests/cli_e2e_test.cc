@@ -16,10 +16,12 @@
 #include <sstream>
 #include <string>
 
+#include "monomap/camera/calibration.h"
 #include "monomap/geometry/polygon.h"
 #include "monomap/io/feature_table.h"
 #include "monomap/io/map_format.h"
 #include "monomap/io/trajectory_io.h"
+#include "monomap/pipelines/mapping_pipeline.h"
 #include "monomap/sim/simulate.h"
 
 namespace monomap {
@@ -535,6 +537,71 @@ TEST_F(Cli, LocalizeTracksTheDatasetInItsMap) {
   EXPECT_EQ(r.exit_code, 1) << r.output;
   EXPECT_NE(r.output.find("odometry2d.txt"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(*root_ / "x.txt"));
+}
+
+// The line of `help` that documents `option` ("" if none).
+std::string HelpLine(const std::string& help, const std::string& option) {
+  std::istringstream in(help);
+  std::string line;
+  while (std::getline(in, line)) {
+    const size_t at = line.find(option + " ");
+    if (at != std::string::npos && line.find_first_not_of(' ') == at) {
+      return line;
+    }
+  }
+  return "";
+}
+
+// CLI11 prints a default as the value streamed into a string.
+template <typename T>
+std::string Shown(const T& value) {
+  std::ostringstream s;
+  s << value;
+  return "[" + s.str() + "]";
+}
+
+// --help shows the defaults of the library's option structs, not copies.
+TEST(CliHelp, BuildShowsTheMappingOptionsDefaults) {
+  const RunResult r = RunMonomap("build --help");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const MappingOptions o;
+  EXPECT_NE(HelpLine(r.output, "--ransac-iterations")
+                .find(Shown(o.planes.ransac_iterations)),
+            std::string::npos)
+      << r.output;
+  EXPECT_NE(HelpLine(r.output, "--keyframe-interval")
+                .find(Shown(o.keyframe_interval)),
+            std::string::npos);
+  EXPECT_NE(
+      HelpLine(r.output, "--features").find(Shown(o.tracking.target_features)),
+      std::string::npos);
+  EXPECT_NE(HelpLine(r.output, "--odometry-translation-sigma")
+                .find(Shown(o.bundle_adjustment.translation_sigma_fraction)),
+            std::string::npos);
+  EXPECT_NE(HelpLine(r.output, "--odometry-span-rotation-sigma-deg")
+                .find(Shown(o.bundle_adjustment.span_rotation_sigma_deg)),
+            std::string::npos);
+}
+
+TEST(CliHelp, SimulateAndCalibrateShowTheirOptionsDefaults) {
+  const RunResult sim = RunMonomap("simulate --help");
+  ASSERT_EQ(sim.exit_code, 0) << sim.output;
+  const SimulationOptions s;
+  EXPECT_NE(HelpLine(sim.output, "--width").find(Shown(s.width)),
+            std::string::npos)
+      << sim.output;
+  EXPECT_NE(HelpLine(sim.output, "--speed").find(Shown(s.path.speed_mps)),
+            std::string::npos);
+  const RunResult cal = RunMonomap("calibrate --help");
+  ASSERT_EQ(cal.exit_code, 0) << cal.output;
+  const CalibrationOptions c;
+  EXPECT_NE(HelpLine(cal.output, "--board")
+                .find("[" + std::to_string(c.inner_corners_x) + "x" +
+                      std::to_string(c.inner_corners_y) + "]"),
+            std::string::npos)
+      << cal.output;
+  EXPECT_NE(HelpLine(cal.output, "--square").find(Shown(c.square_m)),
+            std::string::npos);
 }
 
 }  // namespace

@@ -12,6 +12,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "monomap/camera/calibration.h"
+#include "monomap/util/angles.h"
 #include "monomap/util/error.h"
 
 namespace monomap {
@@ -22,8 +23,6 @@ void BoardPoseOptions::Check() const {
 }
 
 namespace {
-
-constexpr double kRadToDeg = 180.0 / M_PI;
 
 // cam_from_world from OpenCV's rvec/tvec and back.
 Rigid3d FromRvecTvec(const cv::Mat& rvec, const cv::Mat& tvec) {
@@ -133,12 +132,10 @@ std::optional<BoardPose> EstimateBoardPose(const cv::Mat& grey,
     const Eigen::Matrix3d left_jacobian = LeftJacobianSo3(phi);
     const Eigen::Matrix3d rot_cov =
         left_jacobian * cov.topLeftCorner<3, 3>() * left_jacobian.transpose();
-    pose.rotation_sigma_deg =
-        std::sqrt(std::max(
-            0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(rot_cov)
-                     .eigenvalues()
-                     .maxCoeff())) *
-        kRadToDeg;
+    pose.rotation_sigma_deg = RadToDeg(std::sqrt(
+        std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(rot_cov)
+                          .eigenvalues()
+                          .maxCoeff())));
     const Eigen::Vector3d t(tvec.at<double>(0), tvec.at<double>(1),
                             tvec.at<double>(2));
     const Eigen::Matrix3d rt = world_from_cam.RotationMatrix();
@@ -188,6 +185,15 @@ BoardPoseReport EstimateBoardPoses(const std::function<cv::Mat(int)>& load_grey,
   report.rotation_sigma_deg = ComputeErrorStats(rot);
   report.position_sigma_m = ComputeErrorStats(pos);
   return report;
+}
+
+void ExpressInAnchorFrame(const Rigid3d& anchor_world_from_cam,
+                          std::vector<TimedPose>* poses) {
+  if (poses->empty()) return;
+  // anchor_from_board_world, the same for every frame.
+  const Rigid3d change =
+      anchor_world_from_cam * (*poses)[0].world_from_cam.Inverse();
+  for (TimedPose& p : *poses) p.world_from_cam = change * p.world_from_cam;
 }
 
 }  // namespace monomap

@@ -1,38 +1,24 @@
 #include "monomap/texture/mosaic.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <opencv2/imgproc.hpp>
 #include <string>
 #include <unordered_map>
 #include <unordered_set>
 
-#include <Eigen/LU>
-#include <opencv2/imgproc.hpp>
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include "monomap/texture/projection.h"
 #include "monomap/util/error.h"
 #include "monomap/util/progress.h"
+#include "monomap/util/stats.h"
 
 namespace monomap {
 namespace {
-
-template <typename T>
-T MedianInPlace(T* begin, T* end) {
-  const ptrdiff_t n = end - begin;
-  T* mid = begin + n / 2;
-  std::nth_element(begin, mid, end);
-  T m = *mid;
-  if (n % 2 == 0) m = 0.5f * (m + *std::max_element(begin, mid));
-  return m;
-}
-
-double MedianOf(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  return MedianInPlace(v.data(), v.data() + v.size());
-}
 
 inline float Luminance(const float* bgr) {
   return 0.114f * bgr[0] + 0.587f * bgr[1] + 0.299f * bgr[2];
@@ -403,7 +389,7 @@ MosaicReport BuildTexturedPlanes(
       for (const auto* h : selected[p]) {
         if (h->pixels_per_meter > 0) res.push_back(h->pixels_per_meter);
       }
-      ppm = res.empty() ? options.max_pixels_per_meter : MedianOf(res);
+      ppm = res.empty() ? options.max_pixels_per_meter : Median(res);
       ppm = std::min(ppm, options.max_pixels_per_meter);
     }
     ppm = std::min(ppm, options.max_texture_side / extent.maxCoeff());
@@ -529,8 +515,7 @@ MosaicReport BuildTexturedPlanes(
       }
       if (xs.empty()) continue;
       residuals.push_back(
-          (Eigen::Vector2d(MedianOf(xs), MedianOf(ys)) - pf.texture_px)
-              .norm());
+          (Eigen::Vector2d(Median(xs), Median(ys)) - pf.texture_px).norm());
     }
 
     PlaneMosaicStats stats;
@@ -554,7 +539,7 @@ MosaicReport BuildTexturedPlanes(
             std::max(stats.feature_residual_max_px, r);
       }
       stats.feature_residual_mean_px = sum / residuals.size();
-      stats.feature_residual_median_px = MedianOf(residuals);
+      stats.feature_residual_median_px = Median(residuals);
     }
     report.planes.push_back(stats);
     planes->push_back(std::move(tp));

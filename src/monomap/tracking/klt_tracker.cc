@@ -16,6 +16,7 @@
 #include "monomap/tracking/pyramidal_lk.h"
 #include "monomap/util/error.h"
 #include "monomap/util/progress.h"
+#include "monomap/util/stats.h"
 
 namespace monomap {
 
@@ -441,23 +442,15 @@ TrackingReport TrackFeatures(const std::function<cv::Mat(int)>& load_grey,
   std::vector<Track> result = tracker.FinishedTracks(2);
   report.tracks_returned = static_cast<int64_t>(result.size());
   if (!result.empty()) {
-    std::vector<size_t> lengths;
+    std::vector<double> lengths;
     lengths.reserve(result.size());
     double sum = 0.0;
     for (const Track& t : result) {
-      lengths.push_back(t.observations.size());
+      lengths.push_back(static_cast<double>(t.observations.size()));
       sum += static_cast<double>(t.observations.size());
     }
     report.mean_track_length = sum / static_cast<double>(lengths.size());
-    const size_t mid = lengths.size() / 2;
-    std::nth_element(lengths.begin(), lengths.begin() + mid, lengths.end());
-    double median = static_cast<double>(lengths[mid]);
-    if (lengths.size() % 2 == 0) {
-      const size_t lower =
-          *std::max_element(lengths.begin(), lengths.begin() + mid);
-      median = 0.5 * (median + static_cast<double>(lower));
-    }
-    report.median_track_length = median;
+    report.median_track_length = Median(std::move(lengths));
   }
   if (tracks != nullptr) *tracks = std::move(result);
   report.seconds = timer.ElapsedSeconds();

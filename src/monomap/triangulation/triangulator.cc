@@ -1,24 +1,24 @@
 #include "monomap/triangulation/triangulator.h"
 
+#include <ceres/jet.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
 
-#include <ceres/jet.h>
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-#include <Eigen/Cholesky>
-
 #include "monomap/geometry/triangulation.h"
 #include "monomap/triangulation/projection.h"
+#include "monomap/util/angles.h"
 #include "monomap/util/error.h"
 #include "monomap/util/progress.h"
+#include "monomap/util/stats.h"
 
 namespace monomap {
 namespace {
-
-constexpr double kRadToDeg = 180.0 / M_PI;
 
 enum class Outcome : uint8_t {
   kAccepted,
@@ -168,8 +168,7 @@ PointStatistics EvaluatePoint(const Camera& camera,
   const double n = std::max<size_t>(1, track.observations.size());
   s.mean_error_px = sum_error / n;
   s.mean_distance_m = sum_distance / n;
-  s.triangulation_angle_deg =
-      MaxTriangulationAngle(cams, x_in_world) * kRadToDeg;
+  s.triangulation_angle_deg = RadToDeg(MaxTriangulationAngle(cams, x_in_world));
   std::vector<Eigen::Vector2d> observed;
   observed.reserve(track.observations.size());
   for (const Observation& obs : track.observations) observed.push_back(obs.px);
@@ -305,9 +304,7 @@ TriangulationReport TriangulateTracks(const Camera& camera,
     double sum = 0.0;
     for (double e : errors) sum += e;
     report.mean_reprojection_error_px = sum / errors.size();
-    std::nth_element(errors.begin(), errors.begin() + errors.size() / 2,
-                     errors.end());
-    report.median_reprojection_error_px = errors[errors.size() / 2];
+    report.median_reprojection_error_px = UpperMedian(std::move(errors));
   }
   report.seconds = timer.ElapsedSeconds();
   return report;
