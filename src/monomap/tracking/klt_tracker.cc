@@ -370,16 +370,13 @@ std::vector<Track> KltTracker::FinishedTracks(int min_length) const {
   return result;  // tracks_ is indexed by id, hence sorted
 }
 
-TrackingReport TrackFeatures(const std::function<cv::Mat(int)>& load_grey,
-                             int num_frames, const KltTrackerOptions& options,
-                             std::vector<Track>* tracks) {
-  options.Check();
-  if (num_frames < 1) {
-    throw StageError("TrackFeatures: no frames to track");
-  }
-  Timer timer;
-  KltTracker tracker(options);
+namespace {
 
+// Feeds frames 0 .. num_frames-1 to `tracker` in order.
+void TrackAllFrames(const std::function<cv::Mat(int)>& load_grey,
+                    int num_frames, const KltTrackerOptions& options,
+                    KltTracker* tracker_ptr) {
+  KltTracker& tracker = *tracker_ptr;
   struct Item {
     int frame = 0;
     cv::Mat grey;
@@ -426,6 +423,21 @@ TrackingReport TrackFeatures(const std::function<cv::Mat(int)>& load_grey,
                 std::vector<cv::Mat> spare = tracker.ReleaseSparePyramid();
                 if (!spare.empty()) spares.push(std::move(spare));
               }));
+}
+
+}  // namespace
+
+TrackingReport TrackFeatures(const std::function<cv::Mat(int)>& load_grey,
+                             int num_frames, const KltTrackerOptions& options,
+                             std::vector<Track>* tracks) {
+  options.Check();
+  if (num_frames < 1) {
+    throw StageError("TrackFeatures: no frames to track");
+  }
+  Timer timer;
+  KltTracker tracker(options);
+
+  TrackAllFrames(load_grey, num_frames, options, &tracker);
 
   TrackingReport report;
   const KltFrameStats& totals = tracker.TotalStats();
