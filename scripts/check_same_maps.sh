@@ -86,7 +86,13 @@ compare_eval() {
   shift 2
   run_both "$tag" "$@" --json "$OUT/$tag.@WHICH@.json"
   local f result=IDENTICAL detail=""
-  for f in out rc json; do
+  # Output paths in stdout name the run (.ref. / .new.): compare without.
+  if ! cmp -s <(sed 's/\.ref\././g' "$OUT/$tag.ref.out") \
+    <(sed 's/\.new\././g' "$OUT/$tag.new.out"); then
+    result=DIFFERENT
+    detail+=" out"
+  fi
+  for f in rc json; do
     if ! cmp -s "$OUT/$tag.ref.$f" "$OUT/$tag.new.$f"; then
       result=DIFFERENT
       detail+=" $f"
