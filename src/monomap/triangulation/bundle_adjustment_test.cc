@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <random>
 
-#include "monomap/triangulation/synthetic_scene.h"
+#include "monomap/sim/synthetic_scene.h"
 #include "monomap/triangulation/triangulator.h"
 #include "monomap/util/angles.h"
 #include "monomap/util/error.h"

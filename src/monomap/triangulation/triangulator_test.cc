@@ -7,7 +7,7 @@
 #include <algorithm>
 #include <random>
 
-#include "monomap/triangulation/synthetic_scene.h"
+#include "monomap/sim/synthetic_scene.h"
 #include "monomap/util/error.h"
 #include "monomap/util/stats.h"
 

@@ -1,4 +1,4 @@
-#include "monomap/triangulation/synthetic_scene.h"
+#include "monomap/sim/synthetic_scene.h"
 
 #include <algorithm>
 #include <cmath>
