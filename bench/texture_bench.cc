@@ -12,7 +12,7 @@
 
 #include "monomap/texture/image_plane_homography.h"
 #include "monomap/texture/mosaic.h"
-#include "monomap/texture/test_scene.h"
+#include "monomap/sim/textured_plane_scene.h"
 
 namespace monomap {
 namespace {

@@ -10,7 +10,7 @@
 #include <benchmark/benchmark.h>
 
 #include "monomap/triangulation/bundle_adjustment.h"
-#include "monomap/triangulation/synthetic_scene.h"
+#include "monomap/sim/synthetic_scene.h"
 #include "monomap/triangulation/triangulator.h"
 
 namespace monomap {

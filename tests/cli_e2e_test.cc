@@ -16,12 +16,14 @@
 #include <sstream>
 #include <string>
 
+#include "monomap/camera/calibration.h"
 #include "monomap/geometry/polygon.h"
 #include "monomap/io/colmap_export.h"
 #include "monomap/io/feature_table.h"
 #include "monomap/io/map_format.h"
 #include "monomap/io/nav_grid_export.h"
 #include "monomap/io/trajectory_io.h"
+#include "monomap/pipelines/mapping_pipeline.h"
 #include "monomap/sim/simulate.h"
 #include "tests/monomap_cli.h"
 
@@ -583,6 +585,64 @@ TEST_F(Cli, ExportWritesColmapNavGridAndGlb) {
   EXPECT_EQ(r.exit_code, 0);
   EXPECT_EQ(r.output.rfind("monomap 0.", 0), 0u) << r.output;
   EXPECT_NE(r.output.find("commit "), std::string::npos) << r.output;
+}
+
+// The default `help` shows for `option` (CLI11 prints "--name TYPE=VALUE"),
+// "" if none.
+std::string HelpDefault(const std::string& help, const std::string& option) {
+  std::istringstream in(help);
+  std::string line;
+  while (std::getline(in, line)) {
+    std::istringstream words(line);
+    std::string name, type;
+    words >> name >> type;
+    if (name != option) continue;
+    const size_t eq = type.rfind('=');
+    return eq == std::string::npos ? "" : type.substr(eq + 1);
+  }
+  return "";
+}
+
+// CLI11 prints a default as the value streamed into a string.
+template <typename T>
+std::string Shown(const T& value) {
+  std::ostringstream s;
+  s << value;
+  return s.str();
+}
+
+// --help shows the defaults of the library's option structs, not copies.
+TEST(CliHelp, BuildShowsTheMappingOptionsDefaults) {
+  const RunResult r = RunMonomap("build --help");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const MappingOptions o;
+  EXPECT_EQ(HelpDefault(r.output, "--ransac-iterations"),
+            Shown(o.planes.ransac_iterations))
+      << r.output;
+  EXPECT_EQ(HelpDefault(r.output, "--keyframe-interval"),
+            Shown(o.keyframe_interval));
+  EXPECT_EQ(HelpDefault(r.output, "--features"),
+            Shown(o.tracking.target_features));
+  EXPECT_EQ(HelpDefault(r.output, "--odometry-translation-sigma"),
+            Shown(o.bundle_adjustment.translation_sigma_fraction));
+  EXPECT_EQ(HelpDefault(r.output, "--odometry-span-rotation-sigma-deg"),
+            Shown(o.bundle_adjustment.span_rotation_sigma_deg));
+}
+
+TEST(CliHelp, SimulateAndCalibrateShowTheirOptionsDefaults) {
+  const RunResult sim = RunMonomap("simulate --help");
+  ASSERT_EQ(sim.exit_code, 0) << sim.output;
+  const SimulationOptions s;
+  EXPECT_EQ(HelpDefault(sim.output, "--width"), Shown(s.width)) << sim.output;
+  EXPECT_EQ(HelpDefault(sim.output, "--speed"), Shown(s.path.speed_mps));
+  const RunResult cal = RunMonomap("calibrate --help");
+  ASSERT_EQ(cal.exit_code, 0) << cal.output;
+  const CalibrationOptions c;
+  EXPECT_EQ(HelpDefault(cal.output, "--board"),
+            std::to_string(c.inner_corners_x) + "x" +
+                std::to_string(c.inner_corners_y))
+      << cal.output;
+  EXPECT_EQ(HelpDefault(cal.output, "--square"), Shown(c.square_m));
 }
 
 }  // namespace

@@ -6,12 +6,11 @@
 #include <vector>
 
 #include "monomap/camera/board_image_for_tests.h"
+#include "monomap/util/angles.h"
 #include "monomap/util/error.h"
 
 namespace monomap {
 namespace {
-
-constexpr double kDegToRad = M_PI / 180.0;
 
 Camera TrueCamera() {
   Camera c;
@@ -34,9 +33,9 @@ std::vector<Rigid3d> Views() {
     const double roll = -30.0 + 60.0 * (k % 3) / 2.0;
     const double yaw = 20.0 * k;
     const Eigen::Quaterniond look(
-        Eigen::AngleAxisd(yaw * kDegToRad, Eigen::Vector3d::UnitZ()) *
-        Eigen::AngleAxisd(tilt * kDegToRad, Eigen::Vector3d::UnitX()) *
-        Eigen::AngleAxisd(roll * kDegToRad, Eigen::Vector3d::UnitY()));
+        Eigen::AngleAxisd(DegToRad(yaw), Eigen::Vector3d::UnitZ()) *
+        Eigen::AngleAxisd(DegToRad(tilt), Eigen::Vector3d::UnitX()) *
+        Eigen::AngleAxisd(DegToRad(roll), Eigen::Vector3d::UnitY()));
     const Eigen::Vector3d centre(0.16 + 0.02 * std::sin(k), 0.10, 0.0);
     const double distance = 0.3 + 0.1 * (k % 2);
     views.emplace_back(look, centre - look * Eigen::Vector3d(0, 0, distance));

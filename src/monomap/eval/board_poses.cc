@@ -12,6 +12,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "monomap/camera/calibration.h"
+#include "monomap/util/angles.h"
 #include "monomap/util/error.h"
 
 namespace monomap {
@@ -22,8 +23,6 @@ void BoardPoseOptions::Check() const {
 }
 
 namespace {
-
-constexpr double kRadToDeg = 180.0 / M_PI;
 
 // cam_from_world from OpenCV's rvec/tvec and back.
 Rigid3d FromRvecTvec(const cv::Mat& rvec, const cv::Mat& tvec) {
@@ -50,6 +49,44 @@ Eigen::Matrix3d LeftJacobianSo3(const Eigen::Vector3d& phi) {
   const double t2 = theta * theta;
   return Eigen::Matrix3d::Identity() + (1.0 - std::cos(theta)) / t2 * s +
          (theta - std::sin(theta)) / (t2 * theta) * s * s;
+}
+
+// The formal standard deviations of a PnP pose (pose->world_from_cam set)
+// from the projection Jacobian and the residuals' sum of squares.
+void SetFormalSigmas(const cv::Mat& jacobian, double sum_sq,
+                     size_t num_corners, const cv::Mat& rvec,
+                     const cv::Mat& tvec, BoardPose* pose) {
+  const Rigid3d& world_from_cam = pose->world_from_cam;
+  // Covariance of (rvec, tvec): sigma^2 (J^T J)^-1 with sigma from the
+  // residuals (2n - 6 degrees of freedom). A step d in rvec rotates the
+  // camera by w = Jl(rvec) d (SO(3)'s left Jacobian); the camera centre
+  // c = -R^T t then moves by -R^T dt - R^T [t]x w.
+  Eigen::MatrixXd j;
+  cv::cv2eigen(jacobian.colRange(0, 6), j);
+  const double dof = 2.0 * static_cast<double>(num_corners) - 6.0;
+  const Eigen::Matrix<double, 6, 6> cov =
+      (sum_sq / dof) *
+      (j.transpose() * j).ldlt().solve(Eigen::MatrixXd::Identity(6, 6));
+  const Eigen::Vector3d phi(rvec.at<double>(0), rvec.at<double>(1),
+                            rvec.at<double>(2));
+  const Eigen::Matrix3d left_jacobian = LeftJacobianSo3(phi);
+  const Eigen::Matrix3d rot_cov =
+      left_jacobian * cov.topLeftCorner<3, 3>() * left_jacobian.transpose();
+  pose->rotation_sigma_deg = RadToDeg(std::sqrt(
+      std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(rot_cov)
+                        .eigenvalues()
+                        .maxCoeff())));
+  const Eigen::Vector3d t(tvec.at<double>(0), tvec.at<double>(1),
+                          tvec.at<double>(2));
+  const Eigen::Matrix3d rt = world_from_cam.RotationMatrix();
+  Eigen::Matrix<double, 3, 6> dc;  // d(centre) / d(rvec, tvec)
+  dc.leftCols<3>() = -rt * Skew(t) * left_jacobian;
+  dc.rightCols<3>() = -rt;
+  pose->position_sigma_m =
+      std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(
+                                  dc * cov * dc.transpose())
+                                  .eigenvalues()
+                                  .maxCoeff()));
 }
 
 }  // namespace
@@ -118,38 +155,7 @@ std::optional<BoardPose> EstimateBoardPose(const cv::Mat& grey,
     pose.world_from_cam = world_from_cam;
     pose.rms_px = rms;
     pose.median_px = ComputeErrorStats(errors).median;
-    // Covariance of (rvec, tvec): sigma^2 (J^T J)^-1 with sigma from the
-    // residuals (2n - 6 degrees of freedom). A step d in rvec rotates the
-    // camera by w = Jl(rvec) d (SO(3)'s left Jacobian); the camera centre
-    // c = -R^T t then moves by -R^T dt - R^T [t]x w.
-    Eigen::MatrixXd j;
-    cv::cv2eigen(jacobian.colRange(0, 6), j);
-    const double dof = 2.0 * static_cast<double>(corners.size()) - 6.0;
-    const Eigen::Matrix<double, 6, 6> cov =
-        (sum_sq / dof) *
-        (j.transpose() * j).ldlt().solve(Eigen::MatrixXd::Identity(6, 6));
-    const Eigen::Vector3d phi(rvec.at<double>(0), rvec.at<double>(1),
-                              rvec.at<double>(2));
-    const Eigen::Matrix3d left_jacobian = LeftJacobianSo3(phi);
-    const Eigen::Matrix3d rot_cov =
-        left_jacobian * cov.topLeftCorner<3, 3>() * left_jacobian.transpose();
-    pose.rotation_sigma_deg =
-        std::sqrt(std::max(
-            0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(rot_cov)
-                     .eigenvalues()
-                     .maxCoeff())) *
-        kRadToDeg;
-    const Eigen::Vector3d t(tvec.at<double>(0), tvec.at<double>(1),
-                            tvec.at<double>(2));
-    const Eigen::Matrix3d rt = world_from_cam.RotationMatrix();
-    Eigen::Matrix<double, 3, 6> dc;  // d(centre) / d(rvec, tvec)
-    dc.leftCols<3>() = -rt * Skew(t) * left_jacobian;
-    dc.rightCols<3>() = -rt;
-    pose.position_sigma_m =
-        std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(
-                                    dc * cov * dc.transpose())
-                                    .eigenvalues()
-                                    .maxCoeff()));
+    SetFormalSigmas(jacobian, sum_sq, corners.size(), rvec, tvec, &pose);
     best = pose;
     best_angle = angle;
     best_rms = rms;
@@ -188,6 +194,15 @@ BoardPoseReport EstimateBoardPoses(const std::function<cv::Mat(int)>& load_grey,
   report.rotation_sigma_deg = ComputeErrorStats(rot);
   report.position_sigma_m = ComputeErrorStats(pos);
   return report;
+}
+
+void ExpressInAnchorFrame(const Rigid3d& anchor_world_from_cam,
+                          std::vector<TimedPose>* poses) {
+  if (poses->empty()) return;
+  // anchor_from_board_world, the same for every frame.
+  const Rigid3d change =
+      anchor_world_from_cam * (*poses)[0].world_from_cam.Inverse();
+  for (TimedPose& p : *poses) p.world_from_cam = change * p.world_from_cam;
 }
 
 }  // namespace monomap

@@ -75,4 +75,10 @@ BoardPoseReport EstimateBoardPoses(const std::function<cv::Mat(int)>& load_grey,
                                    const CheckerboardSpec& spec,
                                    const BoardPoseOptions& options);
 
+// Re-expresses `poses` (board world) in another frame, e.g. the odometry a
+// map was built in: `anchor_world_from_cam` is the first pose's camera in
+// that frame; the same change of frame applies to every pose.
+void ExpressInAnchorFrame(const Rigid3d& anchor_world_from_cam,
+                          std::vector<TimedPose>* poses);
+
 }  // namespace monomap

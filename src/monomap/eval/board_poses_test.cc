@@ -5,11 +5,10 @@
 #include <cmath>
 
 #include "monomap/camera/board_image_for_tests.h"
+#include "monomap/util/angles.h"
 
 namespace monomap {
 namespace {
-
-constexpr double kDegToRad = M_PI / 180.0;
 
 Camera TestCamera() {
   Camera c;
@@ -34,15 +33,15 @@ cv::Mat RenderBoard(const Camera& camera, const CheckerboardSpec& spec,
 // points away from the camera), tilted by `tilt_deg` about its x axis.
 Rigid3d ViewOfBoard(double tilt_deg, double yaw_deg) {
   const Eigen::Quaterniond down(
-      Eigen::AngleAxisd(yaw_deg * kDegToRad, Eigen::Vector3d::UnitZ()) *
-      Eigen::AngleAxisd(tilt_deg * kDegToRad, Eigen::Vector3d::UnitX()));
+      Eigen::AngleAxisd(DegToRad(yaw_deg), Eigen::Vector3d::UnitZ()) *
+      Eigen::AngleAxisd(DegToRad(tilt_deg), Eigen::Vector3d::UnitX()));
   const Eigen::Vector3d centre(0.16, 0.10, 0.0);
   const Eigen::Vector3d c = centre - down * Eigen::Vector3d(0, 0, 0.35);
   return Rigid3d(down, c);
 }
 
 double RotationErrorDeg(const Rigid3d& a, const Rigid3d& b) {
-  return AngleBetween(a.rotation, b.rotation) / kDegToRad;
+  return RadToDeg(AngleBetween(a.rotation, b.rotation));
 }
 
 TEST(BoardPoses, RecoversTheCameraPoseOfARenderedBoard) {
@@ -54,7 +53,7 @@ TEST(BoardPoses, RecoversTheCameraPoseOfARenderedBoard) {
     // A hint 5 degrees and 1 cm off, as a drifting odometry would give.
     const Rigid3d hint(
         truth.rotation *
-            Eigen::AngleAxisd(5 * kDegToRad, Eigen::Vector3d::UnitY()),
+            Eigen::AngleAxisd(DegToRad(5), Eigen::Vector3d::UnitY()),
         truth.translation + Eigen::Vector3d(0.01, 0, 0));
     const auto pose = EstimateBoardPose(image, camera, spec, hint, {});
     ASSERT_TRUE(pose.has_value()) << tilt;
@@ -109,6 +108,31 @@ TEST(BoardPoses, SequenceReportCountsFramesWithABoard) {
   EXPECT_DOUBLE_EQ(report.poses[1].timestamp, 0.2);
   EXPECT_LT(RotationErrorDeg(report.poses[1].world_from_cam, truth[1]), 0.05);
   EXPECT_LT(report.rms_px.max, 0.15);
+}
+
+TEST(ExpressInAnchorFrameTest, TiesTheFirstPoseAndKeepsRelativeMotion) {
+  std::vector<TimedPose> poses(2);
+  poses[0].world_from_cam = Rigid3d(
+      Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ())),
+      {1.0, 2.0, 3.0});
+  poses[1].world_from_cam =
+      poses[0].world_from_cam * Rigid3d(Eigen::Quaterniond(Eigen::AngleAxisd(
+                                            0.1, Eigen::Vector3d::UnitX())),
+                                        {0.5, 0.0, 0.0});
+  const Rigid3d relative =
+      poses[0].world_from_cam.Inverse() * poses[1].world_from_cam;
+  const Rigid3d anchor(
+      Eigen::Quaterniond(Eigen::AngleAxisd(-1.0, Eigen::Vector3d::UnitY())),
+      {-4.0, 0.0, 1.0});
+  ExpressInAnchorFrame(anchor, &poses);
+  EXPECT_LT((poses[0].world_from_cam.translation - anchor.translation).norm(),
+            1e-12);
+  EXPECT_LT(AngleBetween(poses[0].world_from_cam.rotation, anchor.rotation),
+            1e-12);
+  const Rigid3d after =
+      poses[0].world_from_cam.Inverse() * poses[1].world_from_cam;
+  EXPECT_LT((after.translation - relative.translation).norm(), 1e-12);
+  EXPECT_LT(AngleBetween(after.rotation, relative.rotation), 1e-12);
 }
 
 }  // namespace

@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-#include "monomap/triangulation/synthetic_scene.h"
+#include "monomap/sim/synthetic_scene.h"
 
 namespace monomap {
 namespace {

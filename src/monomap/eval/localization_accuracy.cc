@@ -4,13 +4,12 @@
 #include <limits>
 
 #include "monomap/eval/trajectory_metrics.h"
+#include "monomap/util/angles.h"
 #include "monomap/util/error.h"
 
 namespace monomap {
 
 namespace {
-
-constexpr double kRadToDeg = 180.0 / M_PI;
 
 // NaN (and infinities) as JSON null.
 nlohmann::json Number(double v) {
@@ -68,7 +67,7 @@ LocalizationAccuracy EvaluateLocalization(
     const Rigid3d& e = estimate[i].world_from_cam;
     const Rigid3d& t = groundtruth[g].world_from_cam;
     const double et = (e.translation - t.translation).norm();
-    const double er = AngleBetween(e.rotation, t.rotation) * kRadToDeg;
+    const double er = RadToDeg(AngleBetween(e.rotation, t.rotation));
     a.step.push_back(static_cast<int>(i));
     a.translation_error_m.push_back(et);
     a.rotation_error_deg.push_back(er);

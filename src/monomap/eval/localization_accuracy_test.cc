@@ -5,12 +5,11 @@
 #include <cmath>
 #include <functional>
 
+#include "monomap/util/angles.h"
 #include "monomap/util/error.h"
 
 namespace monomap {
 namespace {
-
-constexpr double kDeg = M_PI / 180.0;
 
 // A robot driving along x at 30 Hz, camera 0.5 m above the floor.
 std::vector<TimedPose> GroundTruth(int n) {
@@ -32,7 +31,7 @@ std::vector<TimedPose> Perturbed(const std::vector<TimedPose>& gt,
   for (int i = 0; i < static_cast<int>(est.size()); ++i) {
     est[i].world_from_cam.translation.y() += offset_m(i);
     est[i].world_from_cam.rotation =
-        YawRotation(yaw_deg(i) * kDeg) * est[i].world_from_cam.rotation;
+        YawRotation(DegToRad(yaw_deg(i))) * est[i].world_from_cam.rotation;
   }
   return est;
 }

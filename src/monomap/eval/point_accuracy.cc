@@ -1,18 +1,19 @@
 #include "monomap/eval/point_accuracy.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <numeric>
 #include <string>
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include "monomap/util/error.h"
 #include "monomap/util/file.h"
+#include "monomap/util/stats.h"
 
 namespace monomap {
 namespace fs = std::filesystem;
@@ -35,8 +36,7 @@ ErrorStats ComputeErrorStats(std::vector<double> values) {
   }
   s.mean = sum / n;
   s.rms = std::sqrt(sum_sq / n);
-  s.median = n % 2 == 1 ? values[n / 2]
-                        : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+  s.median = Median(values);
   // Nearest rank ceil(0.9 n), computed in integers to avoid 0.9 * 10 =
   // 9.000...01 rounding up to rank 10.
   const size_t rank = (9 * n + 9) / 10;
@@ -237,6 +237,40 @@ std::vector<double> NearestNeighborIndex::NearestDistances(
 
 // ---------------------------------------------------------------------------
 // Ground-truth YAML
+
+std::vector<double> DistanceToTrajectory(
+    const std::vector<Eigen::Vector3d>& points,
+    const std::vector<TimedPose>& trajectory) {
+  std::vector<double> d(points.size(), std::numeric_limits<double>::infinity());
+  for (size_t i = 0; i < points.size(); ++i) {
+    for (const auto& p : trajectory) {
+      d[i] = std::min(d[i], (points[i] - p.world_from_cam.translation).norm());
+    }
+  }
+  return d;
+}
+
+std::optional<int> LargestPlaneLabel(const Map& map) {
+  std::map<int, int> counts;
+  for (const auto& l : map.landmarks) {
+    if (l.plane_id >= 0) ++counts[l.plane_id];
+  }
+  if (counts.empty()) return std::nullopt;
+  return std::max_element(counts.begin(), counts.end(),
+                          [](auto& a, auto& b) { return a.second < b.second; })
+      ->first;
+}
+
+std::vector<Eigen::Vector3d> LandmarkPositions(const Map& map,
+                                               int plane_label) {
+  std::vector<Eigen::Vector3d> xs;
+  for (const auto& l : map.landmarks) {
+    if (plane_label == kAllLandmarks || l.plane_id == plane_label) {
+      xs.push_back(l.x_in_world);
+    }
+  }
+  return xs;
+}
 
 Plane ReadGroundTruthPlaneYaml(const fs::path& path) {
   const std::string file = path.string();

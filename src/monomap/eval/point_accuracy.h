@@ -2,14 +2,15 @@
 // desk) or a dense reference cloud (a surface scan).
 #pragma once
 
+#include <Eigen/Core>
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <vector>
 
-#include <Eigen/Core>
-
 #include "monomap/geometry/plane.h"
+#include "monomap/map/map.h"
 
 namespace monomap {
 
@@ -96,6 +97,24 @@ PointAccuracy EvaluatePointsAgainstCloud(
     const std::vector<Eigen::Vector3d>& points,
     const std::vector<double>& distance_to_camera_m,
     const NearestNeighborIndex& cloud);
+
+// Distance from each point to the nearest camera centre of `trajectory`
+// (the "distance to the camera" that relative errors divide by); infinity
+// for an empty trajectory.
+std::vector<double> DistanceToTrajectory(
+    const std::vector<Eigen::Vector3d>& points,
+    const std::vector<TimedPose>& trajectory);
+
+// Plane label with the most landmarks (the lowest such label on a tie);
+// nullopt if no landmark lies on a plane.
+std::optional<int> LargestPlaneLabel(const Map& map);
+
+// Selects all landmarks in LandmarkPositions.
+inline constexpr int kAllLandmarks = -2;
+
+// Positions of the landmarks with plane_id == `plane_label` (-1: on no
+// plane; kAllLandmarks: every landmark), in map order.
+std::vector<Eigen::Vector3d> LandmarkPositions(const Map& map, int plane_label);
 
 // Reads the `plane: {normal: [nx, ny, nz], offset: d}` entry of a
 // ground-truth structure YAML (n . X + d = 0; a non-unit normal is

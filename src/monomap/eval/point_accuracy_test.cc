@@ -246,5 +246,37 @@ TEST_F(PlaneYamlTest, ErrorsNameTheField) {
                InputError);
 }
 
+TEST(DistanceToTrajectoryTest, NearestCameraCentre) {
+  std::vector<TimedPose> trajectory(2);
+  trajectory[1].world_from_cam.translation = {2.0, 0.0, 0.0};
+  const std::vector<double> d = DistanceToTrajectory(
+      {{0.0, 3.0, 0.0}, {2.0, 0.0, 4.0}, {1.0, 0.0, 0.0}}, trajectory);
+  ASSERT_EQ(d.size(), 3u);
+  EXPECT_DOUBLE_EQ(d[0], 3.0);
+  EXPECT_DOUBLE_EQ(d[1], 4.0);
+  EXPECT_DOUBLE_EQ(d[2], 1.0);  // a tie: both centres 1 m away
+  EXPECT_TRUE(std::isinf(DistanceToTrajectory({{0, 0, 0}}, {})[0]));
+}
+
+TEST(LandmarkSelectionTest, LargestPlaneAndPositions) {
+  Map map;
+  EXPECT_FALSE(LargestPlaneLabel(map).has_value());
+  for (const int label : {-1, 2, 5, 5, 2, 7, -1, -1}) {
+    Landmark l;
+    l.plane_id = label;
+    l.x_in_world = Eigen::Vector3d(map.landmarks.size(), 0, 0);
+    map.landmarks.push_back(l);
+  }
+  // 2 and 5 have two points each: the lower label wins; -1 never counts.
+  EXPECT_EQ(LargestPlaneLabel(map), 2);
+  const std::vector<Eigen::Vector3d> on5 = LandmarkPositions(map, 5);
+  ASSERT_EQ(on5.size(), 2u);
+  EXPECT_EQ(on5[0].x(), 2.0);
+  EXPECT_EQ(on5[1].x(), 3.0);
+  EXPECT_EQ(LandmarkPositions(map, -1).size(), 3u);
+  EXPECT_EQ(LandmarkPositions(map, kAllLandmarks).size(), 8u);
+  EXPECT_TRUE(LandmarkPositions(map, 9).empty());
+}
+
 }  // namespace
 }  // namespace monomap

@@ -108,4 +108,27 @@ RenderFidelity EvaluateRenderFidelity(const Map& map, const Camera& camera,
   return result;
 }
 
+std::vector<Rigid3d> MovedAlongCameraX(
+    const std::vector<Rigid3d>& world_from_cam, double offset_m) {
+  std::vector<Rigid3d> moved;
+  for (const Rigid3d& p : world_from_cam) {
+    moved.push_back(
+        p * Rigid3d(Eigen::Quaterniond::Identity(), {offset_m, 0.0, 0.0}));
+  }
+  return moved;
+}
+
+PoseDiscrimination ComparePoses(const RenderFidelity& truth,
+                                const RenderFidelity& wrong) {
+  PoseDiscrimination d;
+  for (const FrameFidelity& a : truth.frames) {
+    for (const FrameFidelity& b : wrong.frames) {
+      if (b.frame != a.frame) continue;
+      ++d.compared;
+      d.true_better += a.ncc > b.ncc ? 1 : 0;
+    }
+  }
+  return d;
+}
+
 }  // namespace monomap

@@ -58,6 +58,29 @@ RenderFidelity EvaluateRenderFidelity(const Map& map, const Camera& camera,
                                       const std::vector<int>& frames,
                                       const RenderFidelityOptions& options);
 
+// Each pose moved `offset_m` along its own camera x axis: a wrong pose to
+// render from, to see how much better the true one matches.
+std::vector<Rigid3d> MovedAlongCameraX(
+    const std::vector<Rigid3d>& world_from_cam, double offset_m);
+
+// Whether renders tell the true pose from a wrong one: a render that
+// matched any pose equally well would say nothing about where the camera
+// is.
+struct PoseDiscrimination {
+  int compared = 0;     // frames compared from both poses
+  int true_better = 0;  // of which the true pose's render has a higher NCC
+  // true_better / compared (0 if none compared).
+  double TrueBetterShare() const {
+    return compared > 0 ? static_cast<double>(true_better) / compared : 0.0;
+  }
+};
+
+// Frame by frame (matched by FrameFidelity::frame): `truth` and `wrong`
+// are EvaluateRenderFidelity of the same frames from the true and the
+// wrong poses.
+PoseDiscrimination ComparePoses(const RenderFidelity& truth,
+                                const RenderFidelity& wrong);
+
 // NCC and gain/offset-compensated PSNR of `render` against `image` (both
 // CV_8UC1, same size) over mask != 0; false if fewer than 2 pixels or one
 // of them is constant there.

@@ -105,5 +105,29 @@ TEST(RenderFidelity, CompareMaskedNeedsTexture) {
   EXPECT_FALSE(CompareMasked(flat, flat, mask, &ncc, &psnr));
 }
 
+TEST(PoseDiscriminationTest, CountsFramesWhereTheTruePoseMatchesBetter) {
+  RenderFidelity truth, wrong;
+  truth.frames = {{0, 0.5, 0.9, 30}, {5, 0.5, 0.4, 20}, {10, 0.5, 0.8, 25}};
+  // Frame 10 was skipped from the wrong pose; frame 15 has no true render.
+  wrong.frames = {{0, 0.5, 0.7, 28}, {5, 0.5, 0.6, 22}, {15, 0.5, 0.1, 10}};
+  const PoseDiscrimination d = ComparePoses(truth, wrong);
+  EXPECT_EQ(d.compared, 2);
+  EXPECT_EQ(d.true_better, 1);
+  EXPECT_DOUBLE_EQ(d.TrueBetterShare(), 0.5);
+  EXPECT_DOUBLE_EQ(PoseDiscrimination().TrueBetterShare(), 0.0);
+}
+
+TEST(PoseDiscriminationTest, MovesAlongEachCamerasOwnXAxis) {
+  const Rigid3d turned(
+      Eigen::Quaterniond(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ())),
+      {1.0, 0.0, 0.0});
+  const std::vector<Rigid3d> moved = MovedAlongCameraX({turned}, 0.25);
+  ASSERT_EQ(moved.size(), 1u);
+  // The camera's x axis points along world +y.
+  EXPECT_LT((moved[0].translation - Eigen::Vector3d(1.0, 0.25, 0.0)).norm(),
+            1e-12);
+  EXPECT_LT(AngleBetween(moved[0].rotation, turned.rotation), 1e-12);
+}
+
 }  // namespace
 }  // namespace monomap

@@ -169,4 +169,119 @@ std::string FormatTable(const StructureAccuracy& a) {
   return out;
 }
 
+nlohmann::json ToJson(const PlaneSurfaceAccuracy& a) {
+  nlohmann::json j;
+  j["num_planes"] = a.planes.size();
+  j["planes"] = nlohmann::json::array();
+  for (const PlaneSurfaceAccuracy::PlaneErrors& p : a.planes) {
+    j["planes"].push_back({{"id", p.id}, {"distance_m", ToJson(p.distance_m)}});
+  }
+  j["all"] = ToJson(a.all);
+  return j;
+}
+
+std::string FormatTable(const PlaneSurfaceAccuracy& a) {
+  std::string table = "plane  samples  median(mm)  p90(mm)  max(mm)\n";
+  char line[160];
+  for (const PlaneSurfaceAccuracy::PlaneErrors& p : a.planes) {
+    const ErrorStats& e = p.distance_m;
+    std::snprintf(line, sizeof(line), "%5d  %7zu  %10.2f  %7.2f  %7.2f\n", p.id,
+                  e.count, e.median * 1e3, e.p90 * 1e3, e.max * 1e3);
+    table += line;
+  }
+  const ErrorStats& e = a.all;
+  std::snprintf(line, sizeof(line), "  all  %7zu  %10.2f  %7.2f  %7.2f\n",
+                e.count, e.median * 1e3, e.p90 * 1e3, e.max * 1e3);
+  return table + line;
+}
+
+nlohmann::json ToJson(const CheckerboardAccuracy& acc,
+                      const CheckerboardSpec& spec) {
+  nlohmann::json j;
+  j["found"] = acc.found;
+  j["plane_id"] = acc.plane_id;
+  j["corners_found"] = acc.corners_found;
+  j["corners_expected"] = spec.inner_corners_x * spec.inner_corners_y;
+  if (acc.found) {
+    j["detector"] = acc.detector;
+    j["error_m"] = ToJson(acc.error_m);
+  }
+  return j;
+}
+
+std::string FormatTable(const CheckerboardAccuracy& acc,
+                        const CheckerboardSpec& spec) {
+  char table[320];
+  std::snprintf(table, sizeof(table),
+                "checkerboard %dx%d: %s in plane %d%s%s, corner error mean "
+                "%.2f mm, median %.2f mm, max %.2f mm\n",
+                spec.inner_corners_x, spec.inner_corners_y,
+                acc.found ? "found" : "NOT found", acc.plane_id,
+                acc.found ? " by " : "", acc.detector.c_str(),
+                acc.error_m.mean * 1e3, acc.error_m.median * 1e3,
+                acc.error_m.max * 1e3);
+  return table;
+}
+
+nlohmann::json ToJson(const BoardPoseReport& report) {
+  nlohmann::json j;
+  j["frames"] = report.frames;
+  j["poses"] = report.poses.size();
+  j["rms_px"] = ToJson(report.rms_px);
+  j["rotation_sigma_deg"] = ToJson(report.rotation_sigma_deg);
+  j["position_sigma_m"] = ToJson(report.position_sigma_m);
+  return j;
+}
+
+std::string FormatTable(const BoardPoseReport& report) {
+  char table[320];
+  std::snprintf(table, sizeof(table),
+                "corner RMS error (px): median %.3f, max %.3f\n"
+                "formal sigma, rotation (deg): median %.4f, max %.4f\n"
+                "formal sigma, camera centre (mm): median %.3f, max %.3f\n",
+                report.rms_px.median, report.rms_px.max,
+                report.rotation_sigma_deg.median, report.rotation_sigma_deg.max,
+                report.position_sigma_m.median * 1e3,
+                report.position_sigma_m.max * 1e3);
+  return table;
+}
+
+nlohmann::json ToJson(const LensResidualReport& report) {
+  nlohmann::json j;
+  j["tracks_used"] = report.tracks_used;
+  j["rings"] = nlohmann::json::array();
+  for (const LensResidualRing& r : report.rings) {
+    j["rings"].push_back({{"min_radius_px", r.min_radius_px},
+                          {"max_radius_px", r.max_radius_px},
+                          {"count", r.count},
+                          {"radial_mean_px", r.radial_mean_px},
+                          {"radial_median_px", r.radial_median_px},
+                          {"tangential_median_px", r.tangential_median_px}});
+  }
+  return j;
+}
+
+std::string FormatTable(const LensResidualReport& report) {
+  std::string table = "tracks used: " + std::to_string(report.tracks_used) +
+                      "\nradius (px)   observations   radial mean  "
+                      "radial median  tangential median (px)\n";
+  for (const LensResidualRing& r : report.rings) {
+    char line[160];
+    std::snprintf(line, sizeof(line),
+                  "%4.0f-%-4.0f %14d %13.3f %14.3f %18.3f\n", r.min_radius_px,
+                  r.max_radius_px, r.count, r.radial_mean_px,
+                  r.radial_median_px, r.tangential_median_px);
+    table += line;
+  }
+  return table;
+}
+
+nlohmann::json ToJson(const StructureAccuracyOptions& o) {
+  return {{"max_match_angle_deg", o.max_match_angle_deg},
+          {"max_match_offset_m", o.max_match_offset_m},
+          {"polygon_margin_m", o.polygon_margin_m},
+          {"min_observed_landmarks", o.min_observed_landmarks},
+          {"observed_distance_m", o.observed_distance_m}};
+}
+
 }  // namespace monomap

@@ -6,6 +6,10 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "monomap/eval/board_poses.h"
+#include "monomap/eval/checkerboard_accuracy.h"
+#include "monomap/eval/lens_residuals.h"
+#include "monomap/eval/plane_accuracy.h"
 #include "monomap/eval/point_accuracy.h"
 #include "monomap/eval/render_fidelity.h"
 #include "monomap/eval/structure_accuracy.h"
@@ -32,6 +36,20 @@ nlohmann::json ToJson(const StructureAccuracy& accuracy);
 // {"compared": n, "skipped": n, "ncc": {...}, "psnr_db": {...},
 //  "coverage": {...}, "frames": [{frame, coverage, ncc, psnr_db}]}
 nlohmann::json ToJson(const RenderFidelity& fidelity);
+// {"num_planes": n, "planes": [{id, distance_m: {...}}], "all": {...}}
+nlohmann::json ToJson(const PlaneSurfaceAccuracy& accuracy);
+// {found, plane_id, corners_found, corners_expected} and, if found,
+// {detector, error_m: {...}}.
+nlohmann::json ToJson(const CheckerboardAccuracy& accuracy,
+                      const CheckerboardSpec& spec);
+// {frames, poses, rms_px, rotation_sigma_deg, position_sigma_m}
+nlohmann::json ToJson(const BoardPoseReport& report);
+// {"tracks_used": n, "rings": [{min_radius_px, max_radius_px, count,
+//  radial_mean_px, radial_median_px, tangential_median_px}]}
+nlohmann::json ToJson(const LensResidualReport& report);
+// The matching thresholds: {max_match_angle_deg, max_match_offset_m,
+// polygon_margin_m, min_observed_landmarks, observed_distance_m}.
+nlohmann::json ToJson(const StructureAccuracyOptions& options);
 
 // Fixed-width tables, one row per quantity, columns count mean median p90
 // max rms; each ends with a newline. Point errors in mm and %.
@@ -44,5 +62,14 @@ std::string FormatTable(const TrajectoryErrors& errors);
 // fitted plane and one per true plane (normal errors in degrees, offsets
 // in mm).
 std::string FormatTable(const StructureAccuracy& accuracy);
+// One row per plane and one for all: samples, median, p90, max (mm).
+std::string FormatTable(const PlaneSurfaceAccuracy& accuracy);
+// One line: found or not, where, corner errors (mm).
+std::string FormatTable(const CheckerboardAccuracy& accuracy,
+                        const CheckerboardSpec& spec);
+// Corner RMS (px) and the formal sigmas (deg, mm): median and max.
+std::string FormatTable(const BoardPoseReport& report);
+// Tracks used, then one row per ring (px).
+std::string FormatTable(const LensResidualReport& report);
 
 }  // namespace monomap

@@ -6,6 +6,7 @@
 #include <unordered_map>
 
 #include "monomap/geometry/polygon.h"
+#include "monomap/util/angles.h"
 #include "monomap/util/error.h"
 
 namespace monomap {
@@ -24,8 +25,6 @@ void StructureAccuracyOptions::Check() const {
 }
 
 namespace {
-
-constexpr double kRadToDeg = 180.0 / M_PI;
 
 // A landmark's nearest true plane among those containing its projection.
 struct Assignment {
@@ -56,10 +55,8 @@ Assignment AssignToTruth(const std::vector<TexturedPlane>& truth,
 void ComparePlanes(const Plane& fitted, const Plane& truth, double* angle_deg,
                    double* offset_m) {
   const double sign = fitted.normal.dot(truth.normal) < 0 ? -1.0 : 1.0;
-  *angle_deg =
-      std::acos(std::clamp(sign * fitted.normal.dot(truth.normal), -1.0,
-                           1.0)) *
-      kRadToDeg;
+  *angle_deg = RadToDeg(
+      std::acos(std::clamp(sign * fitted.normal.dot(truth.normal), -1.0, 1.0)));
   *offset_m = std::abs(sign * fitted.offset - truth.offset);
 }
 

@@ -5,12 +5,11 @@
 #include <cmath>
 
 #include "monomap/eval/report_json.h"
+#include "monomap/util/angles.h"
 #include "monomap/util/error.h"
 
 namespace monomap {
 namespace {
-
-constexpr double kDeg = M_PI / 180.0;
 
 // A true plane: the rectangle origin + [0, w] * u + [0, h] * v.
 TexturedPlane Rectangle(int id, const Eigen::Vector3d& origin,
@@ -138,7 +137,7 @@ TEST(StructureAccuracyTest, TiltedPlaneReportsItsAngle) {
     // The fitted floor tilted about the x axis (through the origin, so the
     // offset stays 0); its inliers still lie on the true floor.
     map.planes[0].plane = ThroughOrigin(
-        {0, -std::sin(tilt_deg * kDeg), std::cos(tilt_deg * kDeg)});
+        {0, -std::sin(DegToRad(tilt_deg)), std::cos(DegToRad(tilt_deg))});
     const StructureAccuracy a =
         EvaluateStructure(map, truth, Rigid3d::Identity(), {});
     const PlaneMatch& m = a.matches[0];
@@ -247,15 +246,13 @@ TEST(StructureAccuracyTest, UnobservedTruePlaneDoesNotCountAgainstRecall) {
 TEST(StructureAccuracyTest, BestOfSeveralFittedPlanesPerTruePlane) {
   const Map truth = Truth();
   Map map = ExactMap(truth);
-  map.planes[0].plane = ThroughOrigin({0, -std::sin(1.0 * kDeg),
-                                       std::cos(1.0 * kDeg)});
+  map.planes[0].plane =
+      ThroughOrigin({0, -std::sin(DegToRad(1.0)), std::cos(DegToRad(1.0))});
   // A second, better segment of the floor, and a third that misses it.
-  map.planes.push_back(
-      Fitted(12, ThroughOrigin({std::sin(0.25 * kDeg), 0,
-                                std::cos(0.25 * kDeg)})));
-  map.planes.push_back(
-      Fitted(13, ThroughOrigin({std::sin(0.1 * kDeg), 0,
-                                std::cos(0.1 * kDeg)})));
+  map.planes.push_back(Fitted(12, ThroughOrigin({std::sin(DegToRad(0.25)), 0,
+                                                 std::cos(DegToRad(0.25))})));
+  map.planes.push_back(Fitted(13, ThroughOrigin({std::sin(DegToRad(0.1)), 0,
+                                                 std::cos(DegToRad(0.1))})));
   map.planes.back().plane.offset = 0.05;  // 5 cm off: no match
   for (int k = 0; k < 20; ++k) map.landmarks[k].plane_id = 12;
   for (int k = 20; k < 40; ++k) map.landmarks[k].plane_id = 13;
@@ -273,7 +270,7 @@ TEST(StructureAccuracyTest, TruthFromMapIsApplied) {
   const Map truth = Truth();
   const Map exact = ExactMap(truth);
   // The same map in a frame rotated by 30 degrees and shifted.
-  const Eigen::AngleAxisd rotation(30 * kDeg, Eigen::Vector3d::UnitZ());
+  const Eigen::AngleAxisd rotation(DegToRad(30), Eigen::Vector3d::UnitZ());
   const Rigid3d map_from_truth(Eigen::Quaterniond(rotation),
                                Eigen::Vector3d(0.5, -1.0, 0.2));
   Map map = exact;
@@ -381,8 +378,8 @@ TEST(StructureAccuracyTest, LandmarkDepthsFromTracksOrNearestCamera) {
 TEST(StructureAccuracyTest, JsonAndTable) {
   const Map truth = Truth();
   Map map = ExactMap(truth);
-  map.planes[0].plane = ThroughOrigin(
-      {0, -std::sin(1.5 * kDeg), std::cos(1.5 * kDeg)});
+  map.planes[0].plane =
+      ThroughOrigin({0, -std::sin(DegToRad(1.5)), std::cos(DegToRad(1.5))});
   const StructureAccuracy a =
       EvaluateStructure(map, truth, Rigid3d::Identity(), {});
   const nlohmann::json j = ToJson(a);

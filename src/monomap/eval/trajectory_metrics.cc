@@ -1,19 +1,17 @@
 #include "monomap/eval/trajectory_metrics.h"
 
+#include <Eigen/Geometry>
+#include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 #include <string>
 
-#include <Eigen/Geometry>
-#include <Eigen/SVD>
-
+#include "monomap/util/angles.h"
 #include "monomap/util/error.h"
 
 namespace monomap {
 
 namespace {
-
-constexpr double kRadToDeg = 180.0 / M_PI;
 
 void CheckSorted(const std::vector<TimedPose>& poses, const char* what) {
   for (size_t i = 1; i < poses.size(); ++i) {
@@ -26,6 +24,15 @@ void CheckSorted(const std::vector<TimedPose>& poses, const char* what) {
 }
 
 }  // namespace
+
+Alignment ParseAlignment(const std::string& name) {
+  if (name == "none") return Alignment::kNone;
+  if (name == "first") return Alignment::kFirstPose;
+  if (name == "se3") return Alignment::kSE3;
+  if (name == "sim3") return Alignment::kSim3;
+  throw OptionsError("alignment: expected none, first, se3 or sim3, got '" +
+                     name + "'");
+}
 
 std::vector<std::pair<size_t, size_t>> AssociateByTimestamp(
     const std::vector<TimedPose>& estimate,
@@ -134,8 +141,8 @@ TrajectoryErrors AbsoluteTrajectoryError(
         sim.scale * (sim.rigid.rotation * e.translation) +
         sim.rigid.translation;
     trans.push_back((p - g.translation).norm());
-    rot.push_back(AngleBetween(sim.rigid.rotation * e.rotation, g.rotation) *
-                  kRadToDeg);
+    rot.push_back(
+        RadToDeg(AngleBetween(sim.rigid.rotation * e.rotation, g.rotation)));
   }
   TrajectoryErrors out;
   out.matched = pairs.size();
@@ -168,8 +175,8 @@ TrajectoryErrors RelativePoseError(const std::vector<TimedPose>& estimate,
                            groundtruth[b.second].world_from_cam;
     const Rigid3d err = rel_gt.Inverse() * rel_est;
     trans.push_back(err.translation.norm());
-    rot.push_back(AngleBetween(err.rotation, Eigen::Quaterniond::Identity()) *
-                  kRadToDeg);
+    rot.push_back(
+        RadToDeg(AngleBetween(err.rotation, Eigen::Quaterniond::Identity())));
   }
   TrajectoryErrors out;
   out.matched = trans.size();

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstddef>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -21,6 +22,10 @@ enum class Alignment {
   kSE3,        // least-squares rigid transform of the positions (Umeyama)
   kSim3,       // least-squares similarity (rigid + scale) of the positions
 };
+
+// "none", "first", "se3" or "sim3" -> Alignment. Throws OptionsError for
+// another name.
+Alignment ParseAlignment(const std::string& name);
 
 struct TrajectoryErrors {
   size_t matched = 0;          // associated pose pairs (ATE) or pose-pair

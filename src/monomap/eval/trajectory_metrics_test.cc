@@ -5,12 +5,11 @@
 #include <cmath>
 #include <random>
 
+#include "monomap/util/angles.h"
 #include "monomap/util/error.h"
 
 namespace monomap {
 namespace {
-
-constexpr double kDeg = M_PI / 180.0;
 
 // A non-planar loop with turning cameras, 10 Hz.
 std::vector<TimedPose> GroundTruth(int n = 200) {
@@ -29,10 +28,10 @@ std::vector<TimedPose> GroundTruth(int n = 200) {
   return poses;
 }
 
-const Rigid3d kWorldChange(
-    Eigen::Quaterniond(Eigen::AngleAxisd(
-        30 * kDeg, Eigen::Vector3d(1, 2, 3).normalized())),
-    Eigen::Vector3d(2.0, -1.0, 0.5));
+const Rigid3d kWorldChange(Eigen::Quaterniond(Eigen::AngleAxisd(
+                               DegToRad(30),
+                               Eigen::Vector3d(1, 2, 3).normalized())),
+                           Eigen::Vector3d(2.0, -1.0, 0.5));
 
 // est = scale * kWorldChange applied to gt, plus noise on positions (sigma
 // per axis, metres in the estimate frame) and rotations (sigma radians).
@@ -72,7 +71,7 @@ TEST(AssociationTest, MatchesWithinMaxDt) {
 
 TEST(AbsoluteTrajectoryErrorTest, SE3RecoversRigidTransform) {
   const auto gt = GroundTruth();
-  const auto est = Transformed(gt, 1.0, 1e-3, 0.1 * kDeg, 7);
+  const auto est = Transformed(gt, 1.0, 1e-3, DegToRad(0.1), 7);
 
   const TrajectoryErrors none =
       AbsoluteTrajectoryError(est, gt, Alignment::kNone, 1e-3);
@@ -93,7 +92,7 @@ TEST(AbsoluteTrajectoryErrorTest, SE3RecoversRigidTransform) {
 
   const Sim3d align = AlignTrajectories(est, gt, Alignment::kSE3, 1e-3);
   const Rigid3d expected = kWorldChange.Inverse();
-  EXPECT_LT(AngleBetween(align.rigid.rotation, expected.rotation) / kDeg,
+  EXPECT_LT(RadToDeg(AngleBetween(align.rigid.rotation, expected.rotation)),
             0.02);
   EXPECT_LT((align.rigid.translation - expected.translation).norm(), 1e-3);
 }
@@ -101,7 +100,7 @@ TEST(AbsoluteTrajectoryErrorTest, SE3RecoversRigidTransform) {
 TEST(AbsoluteTrajectoryErrorTest, Sim3RecoversScale) {
   const auto gt = GroundTruth();
   // Estimate at half scale; 0.5 mm noise there is 1 mm in gt units.
-  const auto est = Transformed(gt, 0.5, 0.5e-3, 0.1 * kDeg, 8);
+  const auto est = Transformed(gt, 0.5, 0.5e-3, DegToRad(0.1), 8);
 
   const TrajectoryErrors se3 =
       AbsoluteTrajectoryError(est, gt, Alignment::kSE3, 1e-3);
@@ -126,9 +125,9 @@ TEST(AbsoluteTrajectoryErrorTest, FirstPoseExactForGlobalTransform) {
   // With noise on the first pose only, its error spreads along the path:
   // a 1 deg yaw error at the first pose moves poses 5 m away by ~9 cm.
   auto perturbed = est;
-  perturbed[0].world_from_cam = perturbed[0].world_from_cam *
-                                Rigid3d(YawRotation(1 * kDeg),
-                                        Eigen::Vector3d::Zero());
+  perturbed[0].world_from_cam =
+      perturbed[0].world_from_cam *
+      Rigid3d(YawRotation(DegToRad(1)), Eigen::Vector3d::Zero());
   const TrajectoryErrors off =
       AbsoluteTrajectoryError(perturbed, gt, Alignment::kFirstPose, 1e-3);
   EXPECT_GT(off.translation_m.max, 0.05);
@@ -158,8 +157,8 @@ TEST(AbsoluteTrajectoryErrorTest, TooFewMatchesOrDegenerate) {
 
 TEST(RelativePoseErrorTest, ConstantPerStepBiasEqualsBias) {
   const auto gt = GroundTruth();
-  const Rigid3d bias(QuaternionFromRotationVector(
-                         0.5 * kDeg * Eigen::Vector3d(0, 0.6, 0.8)),
+  const Rigid3d bias(QuaternionFromRotationVector(DegToRad(0.5) *
+                                                  Eigen::Vector3d(0, 0.6, 0.8)),
                      Eigen::Vector3d(0.01, 0.0, 0.002));
   std::vector<TimedPose> est = gt;
   for (size_t i = 1; i < gt.size(); ++i) {
@@ -197,6 +196,14 @@ TEST(RelativePoseErrorTest, InvariantToGlobalTransformAndChecksArgs) {
   EXPECT_THROW(RelativePoseError(est, gt, 0), OptionsError);
   EXPECT_THROW(RelativePoseError(est, gt, 30), StageError);
   EXPECT_NO_THROW(RelativePoseError(est, gt, 29));
+}
+
+TEST(ParseAlignmentTest, NamesAndErrors) {
+  EXPECT_EQ(ParseAlignment("none"), Alignment::kNone);
+  EXPECT_EQ(ParseAlignment("first"), Alignment::kFirstPose);
+  EXPECT_EQ(ParseAlignment("se3"), Alignment::kSE3);
+  EXPECT_EQ(ParseAlignment("sim3"), Alignment::kSim3);
+  EXPECT_THROW(ParseAlignment("SE3"), OptionsError);
 }
 
 }  // namespace

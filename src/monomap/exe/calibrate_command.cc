@@ -14,12 +14,14 @@ namespace monomap {
 
 void RegisterCalibrateCommand(CLI::App& app) {
   struct Args {
-    std::string dataset, output, board = "9x6";
+    std::string dataset, output, board;
     bool radial_only = false;
     int first_frame = 0, num_frames = -1;
     CalibrationOptions options;
   };
   auto a = std::make_shared<Args>();
+  a->board = std::to_string(a->options.inner_corners_x) + "x" +
+             std::to_string(a->options.inner_corners_y);
   CLI::App* cmd = app.add_subcommand(
       "calibrate",
       "Refit the camera calibration from the dataset's views of a flat "
@@ -28,12 +30,14 @@ void RegisterCalibrateCommand(CLI::App& app) {
   cmd->add_option("-o,--output", a->output,
                   "Calibration to write (ROS camera_info YAML)")
       ->required();
-  cmd->add_option("--board", a->board,
-                  "Inner corners of the board, COLSxROWS (default 9x6)");
+  cmd->add_option("--board", a->board, "Inner corners of the board, COLSxROWS")
+      ->capture_default_str();
   cmd->add_option("--square", a->options.square_m, "Square side (m)")
-      ->check(CLI::PositiveNumber);
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   cmd->add_option("--stride", a->options.stride, "Use every n-th frame")
-      ->check(CLI::PositiveNumber);
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   cmd->add_flag("--radial-only", a->radial_only,
                 "Fit k1, k2 only (no p1, p2, k3)");
   // A fit on part of the sequence can be checked on the rest with

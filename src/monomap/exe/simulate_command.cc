@@ -1,5 +1,8 @@
 // monomap simulate WORLD -o DATASET_DIR [--seed N] [--run-seed N]
 //   [--frames N] [--start-offset M] [--lateral-offset M] ...
+//
+// The options bind to a default-constructed SimulationOptions, so `--help`
+// shows the library's defaults.
 #include <cstdio>
 #include <memory>
 
@@ -28,31 +31,41 @@ void RegisterSimulateCommand(CLI::App& app) {
       ->required();
   cmd->add_option("--seed", o->seed,
                   "Seed of the world (textures) and, without --run-seed, of "
-                  "the run");
+                  "the run")
+      ->capture_default_str();
   cmd->add_option("--run-seed", o->run_seed,
                   "Seed of this traversal: odometry errors, exposure and "
-                  "image noise (0: --seed)");
+                  "image noise (0: --seed)")
+      ->capture_default_str();
   cmd->add_option("--start-offset", o->path.start_offset_m,
-                  "Start this far along the path (m)");
+                  "Start this far along the path (m)")
+      ->capture_default_str();
   cmd->add_option("--lateral-offset", o->path.lateral_offset_m,
-                  "Drive parallel to the path, this far to the left (m)");
+                  "Drive parallel to the path, this far to the left (m)")
+      ->capture_default_str();
   cmd->add_option("--frames", o->num_frames,
-                  "Number of frames (default: the whole path)");
-  cmd->add_option("--width", o->width, "Image width");
-  cmd->add_option("--height", o->height, "Image height");
-  cmd->add_option("--speed", o->path.speed_mps, "Robot speed (m/s)");
+                  "Number of frames (-1: the whole path)")
+      ->capture_default_str();
+  cmd->add_option("--width", o->width, "Image width")->capture_default_str();
+  cmd->add_option("--height", o->height, "Image height")->capture_default_str();
+  cmd->add_option("--speed", o->path.speed_mps, "Robot speed (m/s)")
+      ->capture_default_str();
   cmd->add_option("--odometry-scale-error", o->odometry.wheel_radius_error,
-                  "Systematic wheel radius error (fraction)");
+                  "Systematic wheel radius error (fraction)")
+      ->capture_default_str();
   cmd->add_option("--odometry-yaw-error", o->odometry.yaw_scale_error,
-                  "Systematic yaw scale error (fraction)");
-  cmd->add_option("--odometry-translation-noise",
-                  o->odometry.translation_noise,
-                  "Random translation noise (fraction of each step)");
+                  "Systematic yaw scale error (fraction)")
+      ->capture_default_str();
+  cmd->add_option("--odometry-translation-noise", o->odometry.translation_noise,
+                  "Random translation noise (fraction of each step)")
+      ->capture_default_str();
   cmd->add_option("--odometry-rotation-noise",
                   o->odometry.rotation_noise_per_meter,
-                  "Random rotation noise (rad per metre)");
+                  "Random rotation noise (rad per metre)")
+      ->capture_default_str();
   cmd->add_option("--odometry-seed", o->odometry.seed,
-                  "Seed of the odometry errors");
+                  "Seed of the odometry errors")
+      ->capture_default_str();
   cmd->add_flag("--moving-object", o->moving_object,
                 "Add an object crossing the view");
   cmd->add_flag("--highlight", o->specular_highlight,

@@ -5,6 +5,7 @@
 #include <random>
 
 #include "monomap/geometry/homography.h"
+#include "monomap/util/angles.h"
 
 namespace monomap {
 namespace {
@@ -23,7 +24,7 @@ TEST(Plane, LeastSquaresRecoversNoisyPlane) {
     pts.push_back(f.ToWorld({uni(rng), uni(rng)}) + noise(rng) * truth.normal);
   }
   const Plane fit = FitPlaneLeastSquares(pts);
-  EXPECT_LT(PlaneAngle(fit, truth), 0.2 * M_PI / 180.0);
+  EXPECT_LT(PlaneAngle(fit, truth), DegToRad(0.2));
   for (const auto& p : pts) EXPECT_LT(std::abs(fit.SignedDistance(p)), 0.006);
 }
 

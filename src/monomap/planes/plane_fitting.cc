@@ -11,6 +11,7 @@
 #include "monomap/geometry/polygon.h"
 #include "monomap/util/error.h"
 #include "monomap/util/progress.h"
+#include "monomap/util/stats.h"
 
 namespace monomap {
 
@@ -112,9 +113,7 @@ double MedianNearestNeighbourSpacing(const std::vector<Eigen::Vector2d>& st) {
     if (std::isfinite(best)) nn.push_back(std::sqrt(best));
   }
   if (nn.empty()) return cell;
-  auto mid = nn.begin() + nn.size() / 2;
-  std::nth_element(nn.begin(), mid, nn.end());
-  return *mid;
+  return UpperMedian(std::move(nn));
 }
 
 int FindRoot(std::vector<int>& parent, int i) {

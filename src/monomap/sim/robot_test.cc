@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "monomap/util/angles.h"
 #include "monomap/util/error.h"
 
 namespace monomap {
@@ -59,7 +60,7 @@ TEST(RobotTest, MountLooksForwardAndSlightlyDown) {
   const Eigen::Matrix3d r = base_from_cam.RotationMatrix();
   EXPECT_NEAR(r.determinant(), 1.0, 1e-12);
   const Eigen::Vector3d z = r.col(2), x = r.col(0);
-  EXPECT_NEAR(z.z(), -std::sin(o.tilt_down_deg * M_PI / 180), 1e-12);
+  EXPECT_NEAR(z.z(), -std::sin(DegToRad(o.tilt_down_deg)), 1e-12);
   EXPECT_GT(z.x(), 0.98);
   EXPECT_NEAR(x.y(), -1.0, 1e-12);  // camera x = base right
   EXPECT_NEAR(base_from_cam.translation.z(), o.height_m, 1e-12);

@@ -1,18 +1,19 @@
 #include "monomap/texture/image_plane_homography.h"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
-#include <unordered_map>
-#include <unordered_set>
-
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
-#include <tbb/parallel_for.h>
+#include <unordered_map>
+#include <unordered_set>
 
 #include "monomap/geometry/homography.h"
 #include "monomap/texture/projection.h"
 #include "monomap/util/error.h"
 #include "monomap/util/progress.h"
+#include "monomap/util/stats.h"
 
 namespace monomap {
 namespace {
@@ -46,17 +47,6 @@ std::vector<FeatureSighting> OnPlaneSightings(
     }
   }
   return kept;
-}
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  const size_t mid = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + mid, v.end());
-  double m = v[mid];
-  if (v.size() % 2 == 0) {
-    m = 0.5 * (m + *std::max_element(v.begin(), v.begin() + mid));
-  }
-  return m;
 }
 
 ResidualStats Residuals(const Eigen::Matrix3d& h,

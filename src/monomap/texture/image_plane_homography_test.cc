@@ -6,7 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "monomap/geometry/homography.h"
-#include "monomap/texture/test_scene.h"
+#include "monomap/sim/textured_plane_scene.h"
 #include "monomap/util/error.h"
 
 namespace monomap {

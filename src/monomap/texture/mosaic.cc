@@ -1,38 +1,24 @@
 #include "monomap/texture/mosaic.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <opencv2/imgproc.hpp>
 #include <string>
 #include <unordered_map>
 #include <unordered_set>
 
-#include <Eigen/LU>
-#include <opencv2/imgproc.hpp>
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include "monomap/texture/projection.h"
 #include "monomap/util/error.h"
 #include "monomap/util/progress.h"
+#include "monomap/util/stats.h"
 
 namespace monomap {
 namespace {
-
-template <typename T>
-T MedianInPlace(T* begin, T* end) {
-  const ptrdiff_t n = end - begin;
-  T* mid = begin + n / 2;
-  std::nth_element(begin, mid, end);
-  T m = *mid;
-  if (n % 2 == 0) m = 0.5f * (m + *std::max_element(begin, mid));
-  return m;
-}
-
-double MedianOf(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  return MedianInPlace(v.data(), v.data() + v.size());
-}
 
 inline float Luminance(const float* bgr) {
   return 0.114f * bgr[0] + 0.587f * bgr[1] + 0.299f * bgr[2];
@@ -340,6 +326,238 @@ void MosaicOptions::Check() const {
               "must be >= 0");
 }
 
+namespace {
+
+// Texels per metre of a plane's texture: the option, or the median
+// resolution of its selected views; capped so no side exceeds
+// max_texture_side.
+double TexturePixelsPerMeter(
+    const std::vector<const ImagePlaneHomography*>& selected,
+    const Eigen::Vector2d& extent, const MosaicOptions& options) {
+  double ppm = options.pixels_per_meter;
+  if (ppm <= 0.0) {
+    std::vector<double> res;
+    for (const auto* h : selected) {
+      if (h->pixels_per_meter > 0) res.push_back(h->pixels_per_meter);
+    }
+    ppm = res.empty() ? options.max_pixels_per_meter : Median(res);
+    ppm = std::min(ppm, options.max_pixels_per_meter);
+  }
+  return std::min(ppm, options.max_texture_side / extent.maxCoeff());
+}
+
+// Keeps the cached images this plane's views need and loads the others.
+void LoadViewImages(const std::vector<const ImagePlaneHomography*>& selected,
+                    const ImageLoader& load_image, const Camera& camera,
+                    std::map<int, cv::Mat>* cache) {
+  std::unordered_set<int> needed;
+  for (const auto* h : selected) needed.insert(h->frame);
+  for (auto it = cache->begin(); it != cache->end();) {
+    it = needed.count(it->first) ? std::next(it) : cache->erase(it);
+  }
+  // Decoding dominates the loading: load in parallel. The loader reads
+  // files and keeps no state.
+  std::vector<int> missing;
+  for (const auto* h : selected) {
+    if (!cache->count(h->frame)) missing.push_back(h->frame);
+  }
+  std::vector<cv::Mat> loaded(missing.size());
+  tbb::parallel_for(size_t{0}, missing.size(), [&](size_t i) {
+    loaded[i] = ToBgr(load_image(missing[i]), missing[i], camera);
+  });
+  for (size_t i = 0; i < missing.size(); ++i) {
+    (*cache)[missing[i]] = std::move(loaded[i]);
+  }
+}
+
+// The blended texture (BGRA, alpha 0 where no view saw the plane).
+// Coverage counts go to *inside (texels inside the polygon) and *seen.
+cv::Mat BlendTexture(const PlaneSampler& sampler,
+                     const std::vector<FrameContext>& frames, int width,
+                     int height, const MosaicOptions& options, int* inside,
+                     int* seen) {
+  // Rows are independent: sample all frames for a row and blend it, so
+  // memory stays at one row of samples per thread.
+  cv::Mat texture(height, width, CV_8UC4, cv::Scalar(0, 0, 0, 0));
+  std::vector<int> inside_per_row(height, 0), seen_per_row(height, 0);
+  const int nf = static_cast<int>(frames.size());
+  tbb::parallel_for(
+      tbb::blocked_range<int>(0, height, 4),
+      [&](const tbb::blocked_range<int>& range) {
+        std::vector<float> samples(3 * nf), scratch(nf);
+        for (int r = range.begin(); r < range.end(); ++r) {
+          cv::Vec4b* out = texture.ptr<cv::Vec4b>(r);
+          for (int c = 0; c < width; ++c) {
+            const Eigen::Vector2d st = sampler.PlaneFromTexel(c, r);
+            if (!sampler.Inside(st)) continue;
+            ++inside_per_row[r];
+            int n = 0;
+            for (int f = 0; f < nf; ++f) {
+              float* s = samples.data() + 3 * n;
+              if (sampler.Sample(frames[f], st, s)) {
+                for (int ch = 0; ch < 3; ++ch) s[ch] *= frames[f].gain;
+                ++n;
+              }
+            }
+            if (n == 0) continue;
+            float bgr[3];
+            Blend(options, samples.data(), n, bgr, scratch.data());
+            for (int ch = 0; ch < 3; ++ch) {
+              out[c][ch] = cv::saturate_cast<uint8_t>(bgr[ch]);
+            }
+            out[c][3] = 255;
+            ++seen_per_row[r];
+          }
+        }
+      });
+  *inside = 0;
+  *seen = 0;
+  for (int r = 0; r < height; ++r) {
+    *inside += inside_per_row[r];
+    *seen += seen_per_row[r];
+  }
+  return texture;
+}
+
+// The plane's features (tp->features) and, for each, the distance (texture
+// px) between it and the median of its observations mapped into the
+// texture by every view of the plane (not only the blended ones: more
+// observations, a better median).
+std::vector<double> AddPlaneFeatures(
+    const Camera& camera, const PlaneSegment& seg, const Eigen::Vector2d& lo,
+    const std::vector<const ImagePlaneHomography*>& views,
+    const std::vector<Landmark>& landmarks,
+    const std::unordered_map<FeatureId, const Track*>& track_by_id,
+    const std::unordered_map<FeatureId, const Landmark*>& landmark_by_id,
+    TexturedPlane* tp) {
+  std::unordered_map<int, Eigen::Matrix3d> plane_from_pixel;
+  for (const auto* h : views) {
+    plane_from_pixel[h->frame] = h->pixel_from_plane.inverse();
+  }
+  const double ppm = tp->pixels_per_meter;
+  std::vector<double> residuals;
+  for (FeatureId id : PlaneFeatureIds(seg, landmarks)) {
+    const auto lit = landmark_by_id.find(id);
+    if (lit == landmark_by_id.end()) continue;
+    PlaneFeature pf;
+    pf.id = id;
+    pf.x_in_world = lit->second->x_in_world;
+    pf.texture_px = tp->TextureFromWorld(seg.plane.Project(pf.x_in_world));
+    tp->features.push_back(pf);
+    const auto tit = track_by_id.find(id);
+    if (tit == track_by_id.end()) continue;
+    std::vector<double> xs, ys;
+    for (const Observation& o : tit->second->observations) {
+      const auto hit = plane_from_pixel.find(o.frame);
+      if (hit == plane_from_pixel.end()) continue;
+      const Eigen::Vector3d y =
+          hit->second * UndistortedPixel(camera, o.px).homogeneous();
+      if (std::abs(y.z()) < 1e-12) continue;
+      const Eigen::Vector2d tex =
+          (y.hnormalized() - lo) * ppm - Eigen::Vector2d(0.5, 0.5);
+      xs.push_back(tex.x());
+      ys.push_back(tex.y());
+    }
+    if (xs.empty()) continue;
+    residuals.push_back(
+        (Eigen::Vector2d(Median(xs), Median(ys)) - pf.texture_px).norm());
+  }
+  return residuals;
+}
+
+void SetFeatureResidualStats(const std::vector<double>& residuals,
+                             PlaneMosaicStats* stats) {
+  stats->num_features = static_cast<int>(residuals.size());
+  if (residuals.empty()) return;
+  double sum = 0.0;
+  for (double r : residuals) {
+    sum += r;
+    stats->feature_residual_max_px =
+        std::max(stats->feature_residual_max_px, r);
+  }
+  stats->feature_residual_mean_px = sum / residuals.size();
+  stats->feature_residual_median_px = Median(residuals);
+}
+
+// What every plane's mosaic needs: the inputs, indexed, and the other
+// planes as occluders.
+struct MosaicInputs {
+  const Camera& camera;
+  const std::vector<Rigid3d>& world_from_cam;
+  const std::vector<PlaneSegment>& segments;
+  const std::vector<Landmark>& landmarks;
+  const ImageLoader& load_image;
+  const MosaicOptions& options;
+  std::unordered_map<FeatureId, const Track*> track_by_id;
+  std::unordered_map<FeatureId, const Landmark*> landmark_by_id;
+  std::vector<Occluder> all_occluders;
+  const DistortedProjector projector;
+  const Eigen::Matrix3d k_inv;
+};
+
+// The textured plane of segments[p] from its selected views (all_views:
+// every view, for the feature residuals); images come through *cache.
+TexturedPlane BuildTexturedPlane(
+    const MosaicInputs& in, int p,
+    const std::vector<const ImagePlaneHomography*>& selected,
+    const std::vector<const ImagePlaneHomography*>& all_views,
+    std::map<int, cv::Mat>* cache, PlaneMosaicStats* stats) {
+  const PlaneSegment& seg = in.segments[p];
+  Eigen::Vector2d lo, hi;
+  PolygonBounds(seg.polygon, &lo, &hi);
+  const Eigen::Vector2d extent = (hi - lo).cwiseMax(1e-6);
+  const double ppm = TexturePixelsPerMeter(selected, extent, in.options);
+  const int side = in.options.max_texture_side;
+  const int width =
+      std::clamp(static_cast<int>(std::ceil(extent.x() * ppm)), 1, side);
+  const int height =
+      std::clamp(static_cast<int>(std::ceil(extent.y() * ppm)), 1, side);
+  LoadViewImages(selected, in.load_image, in.camera, cache);
+  std::vector<FrameContext> frames;
+  for (const auto* h : selected) {
+    FrameContext fc;
+    fc.frame = h->frame;
+    fc.image = &(*cache)[h->frame];
+    fc.normalized_from_plane = in.k_inv * h->pixel_from_plane;
+    fc.centre = in.world_from_cam[h->frame].translation;
+    frames.push_back(fc);
+  }
+  std::vector<Occluder> occluders;
+  for (int q = 0; q < static_cast<int>(in.segments.size()); ++q) {
+    if (q != p && in.all_occluders[q].polygon.size() >= 3) {
+      occluders.push_back(in.all_occluders[q]);
+    }
+  }
+  const PlaneSampler sampler(seg, lo, ppm, std::move(occluders), in.projector,
+                             in.options);
+  if (in.options.gain_compensation) {
+    EstimateGains(sampler, width, height, in.options.gain_samples, &frames);
+  }
+  int inside = 0, seen = 0;
+  TexturedPlane tp;
+  tp.id = seg.id;
+  tp.plane = seg.plane;
+  tp.frame = seg.frame;
+  tp.frame.origin = seg.frame.ToWorld(lo);
+  tp.pixels_per_meter = ppm;
+  tp.texture =
+      BlendTexture(sampler, frames, width, height, in.options, &inside, &seen);
+  for (const auto& v : seg.polygon) tp.polygon.push_back(v - lo);
+  const std::vector<double> residuals =
+      AddPlaneFeatures(in.camera, seg, lo, all_views, in.landmarks,
+                       in.track_by_id, in.landmark_by_id, &tp);
+  stats->plane_id = seg.id;
+  stats->pixels_per_meter = ppm;
+  stats->width = width;
+  stats->height = height;
+  for (const auto& fc : frames) stats->frames.push_back(fc.frame);
+  stats->coverage = inside > 0 ? static_cast<double>(seen) / inside : 0.0;
+  SetFeatureResidualStats(residuals, stats);
+  return tp;
+}
+
+}  // namespace
+
 MosaicReport BuildTexturedPlanes(
     const Camera& camera, const std::vector<Rigid3d>& world_from_cam,
     const std::vector<PlaneSegment>& segments,
@@ -354,15 +572,14 @@ MosaicReport BuildTexturedPlanes(
   planes->clear();
   const int num_frames = static_cast<int>(world_from_cam.size());
   const int num_planes = static_cast<int>(segments.size());
-
-  std::unordered_map<FeatureId, const Track*> track_by_id;
-  for (const auto& t : tracks) track_by_id[t.id] = &t;
-  std::unordered_map<FeatureId, const Landmark*> landmark_by_id;
-  for (const auto& l : landmarks) landmark_by_id[l.id] = &l;
-
-  std::vector<Occluder> all_occluders(num_planes);
+  MosaicInputs in{camera,  world_from_cam, segments,
+                  landmarks, load_image,   options,
+                  {},      {},             std::vector<Occluder>(num_planes),
+                  DistortedProjector(camera), camera.K().inverse()};
+  for (const auto& t : tracks) in.track_by_id[t.id] = &t;
+  for (const auto& l : landmarks) in.landmark_by_id[l.id] = &l;
   for (int p = 0; p < num_planes; ++p) {
-    Occluder& o = all_occluders[p];
+    Occluder& o = in.all_occluders[p];
     o.plane = segments[p].plane;
     o.frame = segments[p].frame;
     o.polygon = segments[p].polygon;
@@ -384,180 +601,16 @@ MosaicReport BuildTexturedPlanes(
     selected[p] = SelectFrames(all_views[p], options.max_frames_per_plane);
   }
 
-  const DistortedProjector projector(camera);
-  const Eigen::Matrix3d k_inv = camera.K().inverse();
   std::map<int, cv::Mat> cache;
   for (int p = 0; p < num_planes; ++p) {
-    const PlaneSegment& seg = segments[p];
     if (selected[p].empty()) {
       ++report.num_planes_skipped;
       continue;
     }
-    // Texture geometry.
-    Eigen::Vector2d lo, hi;
-    PolygonBounds(seg.polygon, &lo, &hi);
-    const Eigen::Vector2d extent = (hi - lo).cwiseMax(1e-6);
-    double ppm = options.pixels_per_meter;
-    if (ppm <= 0.0) {
-      std::vector<double> res;
-      for (const auto* h : selected[p]) {
-        if (h->pixels_per_meter > 0) res.push_back(h->pixels_per_meter);
-      }
-      ppm = res.empty() ? options.max_pixels_per_meter : MedianOf(res);
-      ppm = std::min(ppm, options.max_pixels_per_meter);
-    }
-    ppm = std::min(ppm, options.max_texture_side / extent.maxCoeff());
-    const int width = std::clamp(static_cast<int>(std::ceil(extent.x() * ppm)),
-                                 1, options.max_texture_side);
-    const int height = std::clamp(
-        static_cast<int>(std::ceil(extent.y() * ppm)), 1,
-        options.max_texture_side);
-
-    // Images: keep those this plane needs, load the others.
-    std::unordered_set<int> needed;
-    for (const auto* h : selected[p]) needed.insert(h->frame);
-    for (auto it = cache.begin(); it != cache.end();) {
-      it = needed.count(it->first) ? std::next(it) : cache.erase(it);
-    }
-    // Decoding dominates the loading (desk: ~80 JPEGs, 0.3 s on one core):
-    // load in parallel. The loader reads files and keeps no state.
-    std::vector<int> missing;
-    for (const auto* h : selected[p]) {
-      if (!cache.count(h->frame)) missing.push_back(h->frame);
-    }
-    std::vector<cv::Mat> loaded(missing.size());
-    tbb::parallel_for(size_t{0}, missing.size(), [&](size_t i) {
-      loaded[i] = ToBgr(load_image(missing[i]), missing[i], camera);
-    });
-    for (size_t i = 0; i < missing.size(); ++i) {
-      cache[missing[i]] = std::move(loaded[i]);
-    }
-    std::vector<FrameContext> frames;
-    for (const auto* h : selected[p]) {
-      FrameContext fc;
-      fc.frame = h->frame;
-      fc.image = &cache[h->frame];
-      fc.normalized_from_plane = k_inv * h->pixel_from_plane;
-      fc.centre = world_from_cam[h->frame].translation;
-      frames.push_back(fc);
-    }
-
-    std::vector<Occluder> occluders;
-    for (int q = 0; q < num_planes; ++q) {
-      if (q != p && all_occluders[q].polygon.size() >= 3) {
-        occluders.push_back(all_occluders[q]);
-      }
-    }
-    const PlaneSampler sampler(seg, lo, ppm, std::move(occluders), projector,
-                               options);
-    if (options.gain_compensation) {
-      EstimateGains(sampler, width, height, options.gain_samples, &frames);
-    }
-
-    // Rows are independent: sample all frames for a row and blend it, so
-    // memory stays at one row of samples per thread.
-    cv::Mat texture(height, width, CV_8UC4, cv::Scalar(0, 0, 0, 0));
-    std::vector<int> inside_per_row(height, 0), seen_per_row(height, 0);
-    const int nf = static_cast<int>(frames.size());
-    tbb::parallel_for(
-        tbb::blocked_range<int>(0, height, 4),
-        [&](const tbb::blocked_range<int>& range) {
-          std::vector<float> samples(3 * nf), scratch(nf);
-          for (int r = range.begin(); r < range.end(); ++r) {
-            cv::Vec4b* out = texture.ptr<cv::Vec4b>(r);
-            for (int c = 0; c < width; ++c) {
-              const Eigen::Vector2d st = sampler.PlaneFromTexel(c, r);
-              if (!sampler.Inside(st)) continue;
-              ++inside_per_row[r];
-              int n = 0;
-              for (int f = 0; f < nf; ++f) {
-                float* s = samples.data() + 3 * n;
-                if (sampler.Sample(frames[f], st, s)) {
-                  for (int ch = 0; ch < 3; ++ch) s[ch] *= frames[f].gain;
-                  ++n;
-                }
-              }
-              if (n == 0) continue;
-              float bgr[3];
-              Blend(options, samples.data(), n, bgr, scratch.data());
-              for (int ch = 0; ch < 3; ++ch) {
-                out[c][ch] = cv::saturate_cast<uint8_t>(bgr[ch]);
-              }
-              out[c][3] = 255;
-              ++seen_per_row[r];
-            }
-          }
-        });
-
-    TexturedPlane tp;
-    tp.id = seg.id;
-    tp.plane = seg.plane;
-    tp.frame = seg.frame;
-    tp.frame.origin = seg.frame.ToWorld(lo);
-    tp.pixels_per_meter = ppm;
-    tp.texture = texture;
-    for (const auto& v : seg.polygon) tp.polygon.push_back(v - lo);
-
-    // Features and their alignment residual against every view of the
-    // plane (not only the blended ones: more observations, better median).
-    std::unordered_map<int, Eigen::Matrix3d> plane_from_pixel;
-    for (const auto* h : all_views[p]) {
-      plane_from_pixel[h->frame] = h->pixel_from_plane.inverse();
-    }
-    std::vector<double> residuals;
-    for (FeatureId id : PlaneFeatureIds(seg, landmarks)) {
-      const auto lit = landmark_by_id.find(id);
-      if (lit == landmark_by_id.end()) continue;
-      PlaneFeature pf;
-      pf.id = id;
-      pf.x_in_world = lit->second->x_in_world;
-      pf.texture_px = tp.TextureFromWorld(seg.plane.Project(pf.x_in_world));
-      tp.features.push_back(pf);
-      const auto tit = track_by_id.find(id);
-      if (tit == track_by_id.end()) continue;
-      std::vector<double> xs, ys;
-      for (const Observation& o : tit->second->observations) {
-        const auto hit = plane_from_pixel.find(o.frame);
-        if (hit == plane_from_pixel.end()) continue;
-        const Eigen::Vector3d y =
-            hit->second * UndistortedPixel(camera, o.px).homogeneous();
-        if (std::abs(y.z()) < 1e-12) continue;
-        const Eigen::Vector2d tex = (y.hnormalized() - lo) * ppm -
-                                    Eigen::Vector2d(0.5, 0.5);
-        xs.push_back(tex.x());
-        ys.push_back(tex.y());
-      }
-      if (xs.empty()) continue;
-      residuals.push_back(
-          (Eigen::Vector2d(MedianOf(xs), MedianOf(ys)) - pf.texture_px)
-              .norm());
-    }
-
     PlaneMosaicStats stats;
-    stats.plane_id = seg.id;
-    stats.pixels_per_meter = ppm;
-    stats.width = width;
-    stats.height = height;
-    for (const auto& fc : frames) stats.frames.push_back(fc.frame);
-    int inside = 0, seen = 0;
-    for (int r = 0; r < height; ++r) {
-      inside += inside_per_row[r];
-      seen += seen_per_row[r];
-    }
-    stats.coverage = inside > 0 ? static_cast<double>(seen) / inside : 0.0;
-    stats.num_features = static_cast<int>(residuals.size());
-    if (!residuals.empty()) {
-      double sum = 0.0;
-      for (double r : residuals) {
-        sum += r;
-        stats.feature_residual_max_px =
-            std::max(stats.feature_residual_max_px, r);
-      }
-      stats.feature_residual_mean_px = sum / residuals.size();
-      stats.feature_residual_median_px = MedianOf(residuals);
-    }
+    planes->push_back(
+        BuildTexturedPlane(in, p, selected[p], all_views[p], &cache, &stats));
     report.planes.push_back(stats);
-    planes->push_back(std::move(tp));
   }
   report.seconds = timer.ElapsedSeconds();
   return report;

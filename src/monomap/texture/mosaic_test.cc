@@ -6,7 +6,7 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
-#include "monomap/texture/test_scene.h"
+#include "monomap/sim/textured_plane_scene.h"
 #include "monomap/util/error.h"
 
 namespace monomap {

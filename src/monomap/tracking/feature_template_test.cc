@@ -5,6 +5,7 @@
 #include <cmath>
 #include <opencv2/imgproc.hpp>
 
+#include "monomap/util/angles.h"
 #include "monomap/util/error.h"
 
 namespace monomap {
@@ -46,7 +47,7 @@ TEST(FeatureTemplateTest, RecoversAffineWarpUnderExposureChange) {
   ASSERT_TRUE(feature.Extract(reference, centre.cast<float>(), options));
 
   // 12% zoom, 6 degrees of rotation, some shear, a shift; darker image.
-  const double angle = 6.0 * M_PI / 180.0;
+  const double angle = DegToRad(6.0);
   Eigen::Matrix2d rotation;
   rotation << std::cos(angle), -std::sin(angle), std::sin(angle),
       std::cos(angle);

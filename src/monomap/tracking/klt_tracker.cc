@@ -16,6 +16,7 @@
 #include "monomap/tracking/pyramidal_lk.h"
 #include "monomap/util/error.h"
 #include "monomap/util/progress.h"
+#include "monomap/util/stats.h"
 
 namespace monomap {
 
@@ -369,16 +370,13 @@ std::vector<Track> KltTracker::FinishedTracks(int min_length) const {
   return result;  // tracks_ is indexed by id, hence sorted
 }
 
-TrackingReport TrackFeatures(const std::function<cv::Mat(int)>& load_grey,
-                             int num_frames, const KltTrackerOptions& options,
-                             std::vector<Track>* tracks) {
-  options.Check();
-  if (num_frames < 1) {
-    throw StageError("TrackFeatures: no frames to track");
-  }
-  Timer timer;
-  KltTracker tracker(options);
+namespace {
 
+// Feeds frames 0 .. num_frames-1 to `tracker` in order.
+void TrackAllFrames(const std::function<cv::Mat(int)>& load_grey,
+                    int num_frames, const KltTrackerOptions& options,
+                    KltTracker* tracker_ptr) {
+  KltTracker& tracker = *tracker_ptr;
   struct Item {
     int frame = 0;
     cv::Mat grey;
@@ -425,6 +423,21 @@ TrackingReport TrackFeatures(const std::function<cv::Mat(int)>& load_grey,
                 std::vector<cv::Mat> spare = tracker.ReleaseSparePyramid();
                 if (!spare.empty()) spares.push(std::move(spare));
               }));
+}
+
+}  // namespace
+
+TrackingReport TrackFeatures(const std::function<cv::Mat(int)>& load_grey,
+                             int num_frames, const KltTrackerOptions& options,
+                             std::vector<Track>* tracks) {
+  options.Check();
+  if (num_frames < 1) {
+    throw StageError("TrackFeatures: no frames to track");
+  }
+  Timer timer;
+  KltTracker tracker(options);
+
+  TrackAllFrames(load_grey, num_frames, options, &tracker);
 
   TrackingReport report;
   const KltFrameStats& totals = tracker.TotalStats();
@@ -441,23 +454,15 @@ TrackingReport TrackFeatures(const std::function<cv::Mat(int)>& load_grey,
   std::vector<Track> result = tracker.FinishedTracks(2);
   report.tracks_returned = static_cast<int64_t>(result.size());
   if (!result.empty()) {
-    std::vector<size_t> lengths;
+    std::vector<double> lengths;
     lengths.reserve(result.size());
     double sum = 0.0;
     for (const Track& t : result) {
-      lengths.push_back(t.observations.size());
+      lengths.push_back(static_cast<double>(t.observations.size()));
       sum += static_cast<double>(t.observations.size());
     }
     report.mean_track_length = sum / static_cast<double>(lengths.size());
-    const size_t mid = lengths.size() / 2;
-    std::nth_element(lengths.begin(), lengths.begin() + mid, lengths.end());
-    double median = static_cast<double>(lengths[mid]);
-    if (lengths.size() % 2 == 0) {
-      const size_t lower =
-          *std::max_element(lengths.begin(), lengths.begin() + mid);
-      median = 0.5 * (median + static_cast<double>(lower));
-    }
-    report.median_track_length = median;
+    report.median_track_length = Median(std::move(lengths));
   }
   if (tracks != nullptr) *tracks = std::move(result);
   report.seconds = timer.ElapsedSeconds();

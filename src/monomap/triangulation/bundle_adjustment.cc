@@ -16,14 +16,13 @@
 #include "monomap/geometry/triangulation.h"
 #include "monomap/triangulation/projection.h"
 #include "monomap/triangulation/triangulator.h"
+#include "monomap/util/angles.h"
 #include "monomap/util/error.h"
 #include "monomap/util/progress.h"
+#include "monomap/util/stats.h"
 
 namespace monomap {
 namespace {
-
-constexpr double kDegToRad = M_PI / 180.0;
-constexpr double kRadToDeg = 180.0 / M_PI;
 
 // Pose parameters of one frame, one parameter block: cam_from_world as an
 // Eigen quaternion (x, y, z, w memory layout, for
@@ -189,9 +188,7 @@ void RmsAndMedian(std::vector<double> errors, double* rms, double* median) {
   double sum = 0.0;
   for (double e : errors) sum += e * e;
   *rms = std::sqrt(sum / errors.size());
-  std::nth_element(errors.begin(), errors.begin() + errors.size() / 2,
-                   errors.end());
-  *median = errors[errors.size() / 2];
+  *median = UpperMedian(std::move(errors));
 }
 
 // Which landmarks enter the joint adjustment: all if max_points is 0 or not
@@ -228,6 +225,361 @@ std::vector<char> SelectJointPoints(const std::vector<const Track*>& tracks,
     if (!any) break;
   }
   return joint;
+}
+
+// The landmarks' tracks, matched by id. Throws InputError if a landmark
+// has no track or a track refers to a frame without pose.
+std::vector<const Track*> MatchLandmarkTracks(
+    const std::vector<Track>& tracks, const std::vector<Landmark>& landmarks,
+    int num_frames) {
+  std::unordered_map<FeatureId, const Track*> track_by_id;
+  track_by_id.reserve(tracks.size());
+  for (const Track& track : tracks) track_by_id.emplace(track.id, &track);
+  std::vector<const Track*> landmark_tracks;
+  landmark_tracks.reserve(landmarks.size());
+  for (const Landmark& l : landmarks) {
+    const auto it = track_by_id.find(l.id);
+    if (it == track_by_id.end()) {
+      throw InputError("bundle adjustment: landmark " + std::to_string(l.id) +
+                       " has no track");
+    }
+    for (const Observation& obs : it->second->observations) {
+      if (obs.frame < 0 || obs.frame >= num_frames) {
+        throw InputError("bundle adjustment: track " + std::to_string(l.id) +
+                         " observed in frame " + std::to_string(obs.frame) +
+                         " which has no pose (" + std::to_string(num_frames) +
+                         " poses)");
+      }
+    }
+    landmark_tracks.push_back(it->second);
+  }
+  return landmark_tracks;
+}
+
+// One adjustment, in the steps of a classic bundle adjuster: SetUpProblem
+// (reprojection residuals of the joint landmarks, AddLandmarkToProblem),
+// AddOdometryPriors, ParameterizePoses (manifolds, gauge),
+// SetUpSolverOptions, Solve; then the poses are written back, the other
+// landmarks refined alone and the landmarks updated. The order in which
+// blocks enter the problem is fixed: results are reproducible bit for bit.
+class BundleAdjuster {
+ public:
+  BundleAdjuster(const Camera& camera, const BundleAdjustmentOptions& options,
+                 std::vector<const Track*> landmark_tracks,
+                 const std::vector<Rigid3d>& world_from_cam,
+                 const std::vector<Landmark>& landmarks,
+                 BundleAdjustmentReport* report);
+  ~BundleAdjuster() {
+    if (!loss_owned_by_problem_) delete loss_;
+  }
+  BundleAdjuster(const BundleAdjuster&) = delete;
+  BundleAdjuster& operator=(const BundleAdjuster&) = delete;
+
+  // Adds the reprojection residuals; false if there are none (every joint
+  // landmark behind a camera).
+  bool SetUpProblem();
+  void AddOdometryPriors();
+  void ParameterizePoses();
+  ceres::Solver::Options SetUpSolverOptions();
+  // Throws StageError if Ceres fails.
+  void Solve(const ceres::Solver::Options& solver_options);
+  void WriteBackPoses(std::vector<Rigid3d>* world_from_cam);
+  void RefineOtherLandmarks();
+  void UpdateLandmarks(std::vector<Landmark>* landmarks);
+
+ private:
+  void AddLandmarkToProblem(size_t i);
+  // Odometry prior on the relative pose of poses i and j.
+  void AddOdometryPrior(int i, int j, double translation_fraction,
+                        double rotation_floor_deg, double rotation_deg_per_m);
+
+  const Camera& camera_;
+  const internal::Intrinsics intrinsics_;
+  const BundleAdjustmentOptions& options_;
+  const std::vector<const Track*> landmark_tracks_;
+  const std::vector<Rigid3d> odometry_;  // world_from_cam on input
+  const int num_frames_;
+  BundleAdjustmentReport& report_;
+  // Parameter blocks: one pose per frame, one point per landmark, and the
+  // distortion (k1, k2, p1, p2, k3; a block only with refine_distortion).
+  std::vector<PoseParams> poses_;
+  std::vector<Eigen::Vector3d> points_;
+  std::array<double, 5> distortion_;
+  std::vector<Rigid3d> cams_from_world_;
+  std::vector<char> joint_;  // landmarks in the joint problem
+  // Frames adjusted (first_ .. last_); frames outside follow by odometry.
+  int first_ = 0, last_ = 0;
+  Camera adjusted_camera_;  // with the refined distortion
+  ceres::Problem problem_;
+  ceres::LossFunction* loss_ = nullptr;
+  bool loss_owned_by_problem_ = false;
+  int64_t sum_squared_track_length_ = 0;
+};
+
+BundleAdjuster::BundleAdjuster(const Camera& camera,
+                               const BundleAdjustmentOptions& options,
+                               std::vector<const Track*> landmark_tracks,
+                               const std::vector<Rigid3d>& world_from_cam,
+                               const std::vector<Landmark>& landmarks,
+                               BundleAdjustmentReport* report)
+    : camera_(camera),
+      intrinsics_(camera),
+      options_(options),
+      landmark_tracks_(std::move(landmark_tracks)),
+      odometry_(world_from_cam),
+      num_frames_(static_cast<int>(world_from_cam.size())),
+      report_(*report),
+      poses_(num_frames_),
+      points_(landmarks.size()),
+      distortion_(camera.distortion),
+      cams_from_world_(num_frames_),
+      adjusted_camera_(camera) {
+  for (int i = 0; i < num_frames_; ++i) {
+    cams_from_world_[i] = odometry_[i].Inverse();
+    poses_[i] = ToParams(cams_from_world_[i]);
+  }
+  for (size_t i = 0; i < landmarks.size(); ++i) {
+    points_[i] = landmarks[i].x_in_world;
+  }
+  RmsAndMedian(
+      ReprojectionErrors(camera_, cams_from_world_, landmark_tracks_, points_),
+      &report_.initial_rms_error_px, &report_.initial_median_error_px);
+}
+
+bool BundleAdjuster::SetUpProblem() {
+  if (options_.loss == "huber") {
+    loss_ = new ceres::HuberLoss(options_.loss_scale_px);
+  } else if (options_.loss == "cauchy") {
+    loss_ = new ceres::CauchyLoss(options_.loss_scale_px);
+  }
+  joint_ = SelectJointPoints(landmark_tracks_, options_.max_points);
+  for (size_t i = 0; i < points_.size(); ++i) {
+    if (joint_[i]) AddLandmarkToProblem(i);
+  }
+  loss_owned_by_problem_ = report_.num_residuals > 0;
+  if (report_.num_residuals == 0) return false;
+  // Every frame between the first and last observed one takes part, tied by
+  // the odometry priors; frames outside are left as they are.
+  std::vector<bool> observed(num_frames_, false);
+  for (int i = 0; i < num_frames_; ++i) {
+    observed[i] = problem_.HasParameterBlock(poses_[i].v);
+  }
+  first_ = 0;
+  last_ = num_frames_ - 1;
+  while (first_ < num_frames_ && !observed[first_]) ++first_;
+  while (last_ > first_ && !observed[last_]) --last_;
+  // With the first pose as gauge, the chain must start there.
+  if (options_.fix_first_pose) first_ = 0;
+  return true;
+}
+
+void BundleAdjuster::AddLandmarkToProblem(size_t i) {
+  const std::vector<Observation>& observations =
+      landmark_tracks_[i]->observations;
+  // A point behind one of its cameras has no valid residual (Ceres would
+  // fail at the first evaluation): leave it out; it is dropped later.
+  bool in_front = points_[i].allFinite();
+  for (const Observation& obs : observations) {
+    in_front = in_front &&
+               DepthInCamera(cams_from_world_[obs.frame], points_[i]) > 1e-6;
+  }
+  if (!in_front) return;
+  const int64_t k = static_cast<int64_t>(observations.size());
+  sum_squared_track_length_ += k * k;
+  for (const Observation& obs : observations) {
+    PoseParams& p = poses_[obs.frame];
+    if (options_.refine_distortion) {
+      problem_.AddResidualBlock(
+          ReprojectionCost::CreateWithDistortion(intrinsics_, obs.px), loss_,
+          p.v, points_[i].data(), distortion_.data());
+    } else {
+      problem_.AddResidualBlock(ReprojectionCost::Create(intrinsics_, obs.px),
+                                loss_, p.v, points_[i].data());
+    }
+    ++report_.num_residuals;
+  }
+}
+
+void BundleAdjuster::AddOdometryPrior(int i, int j, double translation_fraction,
+                                      double rotation_floor_deg,
+                                      double rotation_deg_per_m) {
+  const Rigid3d measured = odometry_[i].Inverse() * odometry_[j];
+  const double length = measured.translation.norm();
+  const double sigma_t =
+      translation_fraction * length + options_.translation_sigma_floor_m;
+  const double sigma_rot =
+      DegToRad(rotation_floor_deg + rotation_deg_per_m * length);
+  problem_.AddResidualBlock(
+      new ceres::AutoDiffCostFunction<RelativePoseCost, 6, 7, 7>(
+          new RelativePoseCost(measured, sigma_t, sigma_rot)),
+      nullptr, poses_[i].v, poses_[j].v);
+}
+
+void BundleAdjuster::AddOdometryPriors() {
+  for (int i = first_; i + 1 <= last_; ++i) {
+    AddOdometryPrior(i, i + 1, options_.translation_sigma_fraction,
+                     options_.rotation_sigma_floor_deg,
+                     options_.rotation_sigma_deg_per_m);
+    ++report_.num_priors;
+  }
+  if (options_.span_poses <= 0) return;
+  for (int i = first_; i + options_.span_poses <= last_; ++i) {
+    AddOdometryPrior(i, i + options_.span_poses,
+                     options_.span_translation_sigma_fraction,
+                     options_.span_rotation_sigma_deg, 0.0);
+    ++report_.num_span_priors;
+  }
+}
+
+void BundleAdjuster::ParameterizePoses() {
+  for (int i = first_; i <= last_; ++i) {
+    if (problem_.HasParameterBlock(poses_[i].v)) {
+      problem_.SetManifold(poses_[i].v, new PoseManifold);
+      ++report_.num_poses;
+    }
+  }
+  if (!problem_.HasParameterBlock(poses_[first_].v)) return;
+  if (options_.fix_first_pose) {
+    problem_.SetParameterBlockConstant(poses_[first_].v);
+  } else {
+    problem_.AddResidualBlock(
+        new ceres::AutoDiffCostFunction<AbsolutePoseCost, 6, 7>(
+            new AbsolutePoseCost(cams_from_world_[first_],
+                                 options_.translation_sigma_floor_m,
+                                 DegToRad(options_.rotation_sigma_floor_deg))),
+        nullptr, poses_[first_].v);
+  }
+}
+
+ceres::Solver::Options BundleAdjuster::SetUpSolverOptions() {
+  // Schur complement: eliminate the points first.
+  auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
+  for (Eigen::Vector3d& x : points_) {
+    if (problem_.HasParameterBlock(x.data())) {
+      ordering->AddElementToGroup(x.data(), 0);
+      ++report_.num_points_joint;
+    }
+  }
+  int num_pose_blocks = 0;
+  for (int i = first_; i <= last_; ++i) {
+    if (!problem_.HasParameterBlock(poses_[i].v)) continue;
+    ordering->AddElementToGroup(poses_[i].v, 1);
+    ++num_pose_blocks;
+  }
+  if (problem_.HasParameterBlock(distortion_.data())) {
+    ordering->AddElementToGroup(distortion_.data(), 1);
+  }
+  report_.covisibility =
+      static_cast<double>(sum_squared_track_length_) / report_.num_residuals;
+  // CG instead of the dense solver only: the sparse one is fast on its own.
+  const bool dense = num_pose_blocks <= options_.dense_schur_max_poses;
+  const bool iterative =
+      options_.iterative_schur ||
+      (dense && options_.iterative_schur_min_covisibility > 0.0 &&
+       report_.covisibility > options_.iterative_schur_min_covisibility);
+  ceres::Solver::Options solver_options;
+  solver_options.linear_solver_type = iterative ? ceres::ITERATIVE_SCHUR
+                                      : dense   ? ceres::DENSE_SCHUR
+                                                : ceres::SPARSE_SCHUR;
+  if (iterative) {
+    solver_options.preconditioner_type = ceres::SCHUR_JACOBI;
+    solver_options.eta = options_.iterative_schur_eta;
+  }
+  report_.linear_solver =
+      ceres::LinearSolverTypeToString(solver_options.linear_solver_type);
+  solver_options.linear_solver_ordering = ordering;
+  // Odometry is a good start, so begin close to Gauss-Newton: the strong
+  // default damping stalls the weakly constrained directions (scale, which
+  // only the priors hold) over many iterations.
+  solver_options.initial_trust_region_radius = 1e8;
+  solver_options.max_num_iterations = options_.max_num_iterations;
+  solver_options.function_tolerance = options_.function_tolerance;
+  solver_options.num_threads = options_.num_threads;
+  solver_options.minimizer_progress_to_stdout = options_.verbose;
+  solver_options.logging_type =
+      options_.verbose ? ceres::PER_MINIMIZER_ITERATION : ceres::SILENT;
+  return solver_options;
+}
+
+void BundleAdjuster::Solve(const ceres::Solver::Options& solver_options) {
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver_options, &problem_, &summary);
+  if (options_.verbose) std::cout << summary.FullReport() << "\n";
+  report_.iterations = static_cast<int>(summary.iterations.size());
+  report_.termination =
+      ceres::TerminationTypeToString(summary.termination_type);
+  if (summary.termination_type == ceres::FAILURE) {
+    throw StageError("bundle adjustment failed: " + summary.message);
+  }
+  // From here on (landmarks refined alone, errors, filtering) the refined
+  // lens.
+  adjusted_camera_.distortion = distortion_;
+  report_.distortion = distortion_;
+}
+
+void BundleAdjuster::WriteBackPoses(std::vector<Rigid3d>* world_from_cam) {
+  std::vector<Rigid3d>& w = *world_from_cam;
+  for (int i = first_; i <= last_; ++i) w[i] = FromParams(poses_[i]).Inverse();
+  // Frames outside the adjusted range follow their nearest adjusted frame
+  // by the odometry motion, so the trajectory stays continuous.
+  for (int i = last_ + 1; i < num_frames_; ++i) {
+    w[i] = w[last_] * (odometry_[last_].Inverse() * odometry_[i]);
+  }
+  for (int i = first_ - 1; i >= 0; --i) {
+    w[i] = w[first_] * (odometry_[first_].Inverse() * odometry_[i]);
+  }
+  double sum_change_m = 0.0, sum_change_rad = 0.0;
+  for (int i = 0; i < num_frames_; ++i) {
+    cams_from_world_[i] = w[i].Inverse();
+    sum_change_m += (w[i].translation - odometry_[i].translation).norm();
+    sum_change_rad += AngleBetween(w[i].rotation, odometry_[i].rotation);
+  }
+  report_.mean_pose_change_m = sum_change_m / num_frames_;
+  report_.mean_pose_change_deg = RadToDeg(sum_change_rad / num_frames_);
+}
+
+void BundleAdjuster::RefineOtherLandmarks() {
+  // Landmarks left out of the joint problem: refined alone with the
+  // adjusted poses held fixed.
+  const TriangulationOptions refine_options;
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, points_.size(), 64),
+                    [&](const tbb::blocked_range<size_t>& range) {
+                      for (size_t i = range.begin(); i != range.end(); ++i) {
+                        if (joint_[i] || !points_[i].allFinite()) continue;
+                        RefinePoint(adjusted_camera_, cams_from_world_,
+                                    *landmark_tracks_[i], refine_options,
+                                    &points_[i]);
+                      }
+                    });
+  RmsAndMedian(ReprojectionErrors(adjusted_camera_, cams_from_world_,
+                                  landmark_tracks_, points_),
+               &report_.final_rms_error_px, &report_.final_median_error_px);
+}
+
+void BundleAdjuster::UpdateLandmarks(std::vector<Landmark>* landmarks) {
+  // Drop the landmarks bundle adjustment could not reconcile.
+  std::vector<Landmark> kept;
+  kept.reserve(landmarks->size());
+  for (size_t i = 0; i < landmarks->size(); ++i) {
+    Landmark l = (*landmarks)[i];
+    const PointStatistics s = EvaluatePoint(adjusted_camera_, cams_from_world_,
+                                            *landmark_tracks_[i], points_[i]);
+    if (!points_[i].allFinite() ||
+        s.mean_error_px > options_.max_reprojection_error_px ||
+        s.min_depth_m < options_.min_depth_m) {
+      ++report_.num_dropped;
+      continue;
+    }
+    l.x_in_world = points_[i];
+    l.num_observations =
+        static_cast<int>(landmark_tracks_[i]->observations.size());
+    l.mean_reprojection_error_px = s.mean_error_px;
+    l.triangulation_angle_deg = s.triangulation_angle_deg;
+    l.mean_depth_m = s.mean_distance_m;
+    l.covariance_m2_per_px2 = s.covariance_m2_per_px2;
+    kept.push_back(l);
+  }
+  *landmarks = std::move(kept);
 }
 
 }  // namespace
@@ -272,292 +624,30 @@ BundleAdjustmentReport BundleAdjust(const Camera& camera,
   const Timer timer;
   BundleAdjustmentReport report;
   report.distortion = camera.distortion;
-  const int num_frames = static_cast<int>(world_from_cam->size());
-
-  // Match landmarks to their tracks by id.
-  std::unordered_map<FeatureId, const Track*> track_by_id;
-  track_by_id.reserve(tracks.size());
-  for (const Track& track : tracks) track_by_id.emplace(track.id, &track);
-  std::vector<const Track*> landmark_tracks;
-  landmark_tracks.reserve(landmarks->size());
-  for (const Landmark& l : *landmarks) {
-    const auto it = track_by_id.find(l.id);
-    if (it == track_by_id.end()) {
-      throw InputError("bundle adjustment: landmark " + std::to_string(l.id) +
-                       " has no track");
-    }
-    for (const Observation& obs : it->second->observations) {
-      if (obs.frame < 0 || obs.frame >= num_frames) {
-        throw InputError("bundle adjustment: track " + std::to_string(l.id) +
-                         " observed in frame " + std::to_string(obs.frame) +
-                         " which has no pose (" + std::to_string(num_frames) +
-                         " poses)");
-      }
-    }
-    landmark_tracks.push_back(it->second);
-  }
-
-  const std::vector<Rigid3d> odometry = *world_from_cam;
-  std::vector<PoseParams> poses(num_frames);
-  std::vector<Rigid3d> cams_from_world(num_frames);
-  for (int i = 0; i < num_frames; ++i) {
-    cams_from_world[i] = odometry[i].Inverse();
-    poses[i] = ToParams(cams_from_world[i]);
-  }
-  std::vector<Eigen::Vector3d> points(landmarks->size());
-  for (size_t i = 0; i < landmarks->size(); ++i) {
-    points[i] = (*landmarks)[i].x_in_world;
-  }
-  RmsAndMedian(
-      ReprojectionErrors(camera, cams_from_world, landmark_tracks, points),
-      &report.initial_rms_error_px, &report.initial_median_error_px);
   report.num_points = static_cast<int>(landmarks->size());
-
-  if (!options.enabled || landmarks->empty() || num_frames == 0) {
+  const int num_frames = static_cast<int>(world_from_cam->size());
+  BundleAdjuster adjuster(camera, options,
+                          MatchLandmarkTracks(tracks, *landmarks, num_frames),
+                          *world_from_cam, *landmarks, &report);
+  const bool nothing_to_adjust = landmarks->empty() || num_frames == 0;
+  if (!options.enabled || nothing_to_adjust || !adjuster.SetUpProblem()) {
+    if (options.enabled && !nothing_to_adjust) {
+      // Every landmark was behind a camera: all dropped.
+      report.num_dropped = static_cast<int>(landmarks->size());
+      landmarks->clear();
+    }
     report.final_rms_error_px = report.initial_rms_error_px;
     report.final_median_error_px = report.initial_median_error_px;
     report.termination = options.enabled ? "nothing to adjust" : "disabled";
     report.seconds = timer.ElapsedSeconds();
     return report;
   }
-
-  ceres::Problem problem;
-  const internal::Intrinsics intrinsics(camera);
-  ceres::LossFunction* loss = nullptr;
-  if (options.loss == "huber") {
-    loss = new ceres::HuberLoss(options.loss_scale_px);
-  } else if (options.loss == "cauchy") {
-    loss = new ceres::CauchyLoss(options.loss_scale_px);
-  }
-  const std::vector<char> joint =
-      SelectJointPoints(landmark_tracks, options.max_points);
-  // k1, k2, p1, p2, k3; a parameter block only with refine_distortion.
-  std::array<double, 5> distortion = camera.distortion;
-  std::vector<bool> observed(num_frames, false);
-  int64_t sum_squared_track_length = 0;
-  for (size_t i = 0; i < points.size(); ++i) {
-    if (!joint[i]) continue;
-    // A point behind one of its cameras has no valid residual (Ceres would
-    // fail at the first evaluation): leave it out; it is dropped below.
-    bool in_front = points[i].allFinite();
-    for (const Observation& obs : landmark_tracks[i]->observations) {
-      in_front = in_front &&
-                 DepthInCamera(cams_from_world[obs.frame], points[i]) > 1e-6;
-    }
-    if (!in_front) continue;
-    const int64_t k =
-        static_cast<int64_t>(landmark_tracks[i]->observations.size());
-    sum_squared_track_length += k * k;
-    for (const Observation& obs : landmark_tracks[i]->observations) {
-      PoseParams& p = poses[obs.frame];
-      if (options.refine_distortion) {
-        problem.AddResidualBlock(
-            ReprojectionCost::CreateWithDistortion(intrinsics, obs.px), loss,
-            p.v, points[i].data(), distortion.data());
-      } else {
-        problem.AddResidualBlock(ReprojectionCost::Create(intrinsics, obs.px),
-                                 loss, p.v, points[i].data());
-      }
-      observed[obs.frame] = true;
-      ++report.num_residuals;
-    }
-  }
-  if (report.num_residuals == 0) {
-    // Every landmark was behind a camera: nothing to adjust, all dropped.
-    report.num_dropped = static_cast<int>(landmarks->size());
-    landmarks->clear();
-    delete loss;
-    report.final_rms_error_px = report.initial_rms_error_px;
-    report.final_median_error_px = report.initial_median_error_px;
-    report.termination = "nothing to adjust";
-    report.seconds = timer.ElapsedSeconds();
-    return report;
-  }
-  // Every frame between the first and last observed one takes part, tied by
-  // the odometry priors; frames outside are left as they are.
-  int first = 0, last = num_frames - 1;
-  while (first < num_frames && !observed[first]) ++first;
-  while (last > first && !observed[last]) --last;
-  // With the first pose as gauge, the chain must start there.
-  if (options.fix_first_pose) first = 0;
-  // Odometry prior on the relative pose of poses i and j.
-  auto add_prior = [&](int i, int j, double translation_fraction,
-                       double rotation_floor_deg, double rotation_deg_per_m) {
-    const Rigid3d measured = odometry[i].Inverse() * odometry[j];
-    const double length = measured.translation.norm();
-    const double sigma_t =
-        translation_fraction * length + options.translation_sigma_floor_m;
-    const double sigma_rot =
-        (rotation_floor_deg + rotation_deg_per_m * length) * kDegToRad;
-    problem.AddResidualBlock(
-        new ceres::AutoDiffCostFunction<RelativePoseCost, 6, 7, 7>(
-            new RelativePoseCost(measured, sigma_t, sigma_rot)),
-        nullptr, poses[i].v, poses[j].v);
-  };
-  for (int i = first; i + 1 <= last; ++i) {
-    add_prior(i, i + 1, options.translation_sigma_fraction,
-              options.rotation_sigma_floor_deg,
-              options.rotation_sigma_deg_per_m);
-    ++report.num_priors;
-  }
-  if (options.span_poses > 0) {
-    for (int i = first; i + options.span_poses <= last; ++i) {
-      add_prior(i, i + options.span_poses,
-                options.span_translation_sigma_fraction,
-                options.span_rotation_sigma_deg, 0.0);
-      ++report.num_span_priors;
-    }
-  }
-  for (int i = first; i <= last; ++i) {
-    if (problem.HasParameterBlock(poses[i].v)) {
-      problem.SetManifold(poses[i].v, new PoseManifold);
-      ++report.num_poses;
-    }
-  }
-  if (problem.HasParameterBlock(poses[first].v)) {
-    if (options.fix_first_pose) {
-      problem.SetParameterBlockConstant(poses[first].v);
-    } else {
-      problem.AddResidualBlock(
-          new ceres::AutoDiffCostFunction<AbsolutePoseCost, 6, 7>(
-              new AbsolutePoseCost(
-                  cams_from_world[first], options.translation_sigma_floor_m,
-                  options.rotation_sigma_floor_deg * kDegToRad)),
-          nullptr, poses[first].v);
-    }
-  }
-
-  // Schur complement: eliminate the points first.
-  auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
-  for (Eigen::Vector3d& x : points) {
-    if (problem.HasParameterBlock(x.data())) {
-      ordering->AddElementToGroup(x.data(), 0);
-      ++report.num_points_joint;
-    }
-  }
-  for (int i = first; i <= last; ++i) {
-    if (!problem.HasParameterBlock(poses[i].v)) continue;
-    ordering->AddElementToGroup(poses[i].v, 1);
-  }
-  if (problem.HasParameterBlock(distortion.data())) {
-    ordering->AddElementToGroup(distortion.data(), 1);
-  }
-
-  ceres::Solver::Options solver_options;
-  int num_pose_blocks = 0;
-  for (int i = first; i <= last; ++i) {
-    num_pose_blocks += problem.HasParameterBlock(poses[i].v) ? 1 : 0;
-  }
-  report.covisibility = report.num_residuals > 0
-                            ? static_cast<double>(sum_squared_track_length) /
-                                  report.num_residuals
-                            : 0.0;
-  // CG instead of the dense solver only: the sparse one is fast on its own.
-  const bool dense = num_pose_blocks <= options.dense_schur_max_poses;
-  const bool iterative =
-      options.iterative_schur ||
-      (dense && options.iterative_schur_min_covisibility > 0.0 &&
-       report.covisibility > options.iterative_schur_min_covisibility);
-  solver_options.linear_solver_type =
-      iterative ? ceres::ITERATIVE_SCHUR
-      : dense   ? ceres::DENSE_SCHUR
-                : ceres::SPARSE_SCHUR;
-  if (iterative) {
-    solver_options.preconditioner_type = ceres::SCHUR_JACOBI;
-    solver_options.eta = options.iterative_schur_eta;
-  }
-  report.linear_solver =
-      ceres::LinearSolverTypeToString(solver_options.linear_solver_type);
-  solver_options.linear_solver_ordering = ordering;
-  // Odometry is a good start, so begin close to Gauss-Newton: the strong
-  // default damping stalls the weakly constrained directions (scale, which
-  // only the priors hold) over many iterations.
-  solver_options.initial_trust_region_radius = 1e8;
-  solver_options.max_num_iterations = options.max_num_iterations;
-  solver_options.function_tolerance = options.function_tolerance;
-  solver_options.num_threads = options.num_threads;
-  solver_options.minimizer_progress_to_stdout = options.verbose;
-  solver_options.logging_type =
-      options.verbose ? ceres::PER_MINIMIZER_ITERATION : ceres::SILENT;
-  ceres::Solver::Summary summary;
-  ceres::Solve(solver_options, &problem, &summary);
-  if (options.verbose) std::cout << summary.FullReport() << "\n";
-  report.iterations = static_cast<int>(summary.iterations.size());
-  report.termination = ceres::TerminationTypeToString(summary.termination_type);
-  if (summary.termination_type == ceres::FAILURE) {
-    throw StageError("bundle adjustment failed: " + summary.message);
-  }
-  // From here on (landmarks refined alone, errors, filtering) the refined
-  // lens.
-  Camera adjusted_camera = camera;
-  adjusted_camera.distortion = distortion;
-  report.distortion = distortion;
-
-  // Write back poses and their change.
-  double sum_change_m = 0.0, sum_change_rad = 0.0;
-  for (int i = first; i <= last; ++i) {
-    (*world_from_cam)[i] = FromParams(poses[i]).Inverse();
-  }
-  // Frames outside the adjusted range follow their nearest adjusted frame
-  // by the odometry motion, so the trajectory stays continuous.
-  for (int i = last + 1; i < num_frames; ++i) {
-    (*world_from_cam)[i] =
-        (*world_from_cam)[last] * (odometry[last].Inverse() * odometry[i]);
-  }
-  for (int i = first - 1; i >= 0; --i) {
-    (*world_from_cam)[i] =
-        (*world_from_cam)[first] * (odometry[first].Inverse() * odometry[i]);
-  }
-  for (int i = 0; i < num_frames; ++i) {
-    cams_from_world[i] = (*world_from_cam)[i].Inverse();
-    sum_change_m +=
-        ((*world_from_cam)[i].translation - odometry[i].translation).norm();
-    sum_change_rad +=
-        AngleBetween((*world_from_cam)[i].rotation, odometry[i].rotation);
-  }
-  report.mean_pose_change_m = sum_change_m / num_frames;
-  report.mean_pose_change_deg = sum_change_rad / num_frames * kRadToDeg;
-
-  // Landmarks left out of the joint problem: refined alone with the
-  // adjusted poses held fixed.
-  const TriangulationOptions refine_options;
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, points.size(), 64),
-                    [&](const tbb::blocked_range<size_t>& range) {
-                      for (size_t i = range.begin(); i != range.end(); ++i) {
-                        if (joint[i] || !points[i].allFinite()) continue;
-                        RefinePoint(adjusted_camera, cams_from_world,
-                                    *landmark_tracks[i], refine_options,
-                                    &points[i]);
-                      }
-                    });
-
-  RmsAndMedian(ReprojectionErrors(adjusted_camera, cams_from_world,
-                                  landmark_tracks, points),
-               &report.final_rms_error_px, &report.final_median_error_px);
-
-  // Update landmarks; drop the ones bundle adjustment could not reconcile.
-  std::vector<Landmark> kept;
-  kept.reserve(landmarks->size());
-  for (size_t i = 0; i < landmarks->size(); ++i) {
-    Landmark l = (*landmarks)[i];
-    const PointStatistics s = EvaluatePoint(adjusted_camera, cams_from_world,
-                                            *landmark_tracks[i], points[i]);
-    if (!points[i].allFinite() ||
-        s.mean_error_px > options.max_reprojection_error_px ||
-        s.min_depth_m < options.min_depth_m) {
-      ++report.num_dropped;
-      continue;
-    }
-    l.x_in_world = points[i];
-    l.num_observations =
-        static_cast<int>(landmark_tracks[i]->observations.size());
-    l.mean_reprojection_error_px = s.mean_error_px;
-    l.triangulation_angle_deg = s.triangulation_angle_deg;
-    l.mean_depth_m = s.mean_distance_m;
-    l.covariance_m2_per_px2 = s.covariance_m2_per_px2;
-    kept.push_back(l);
-  }
-  *landmarks = std::move(kept);
+  adjuster.AddOdometryPriors();
+  adjuster.ParameterizePoses();
+  adjuster.Solve(adjuster.SetUpSolverOptions());
+  adjuster.WriteBackPoses(world_from_cam);
+  adjuster.RefineOtherLandmarks();
+  adjuster.UpdateLandmarks(landmarks);
   report.seconds = timer.ElapsedSeconds();
   return report;
 }

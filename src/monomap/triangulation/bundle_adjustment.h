@@ -46,12 +46,9 @@ struct BundleAdjustmentOptions {
   // Odometry prior over longer spans: between poses i and i + span_poses of
   // the adjustment (keyframes, when the pipeline adjusts keyframes), for
   // every i; 0: off. The per-step priors model the odometry's error as
-  // independent increments, which accumulate. An odometry whose error is
-  // mostly per-frame jitter that does not accumulate (desk_vamr_a's, made
-  // from board poses that jitter by ~0.05 deg a frame) is then trusted too
-  // much step by step, and too little over a span. With span priors the
-  // per-step rotation sigma can be loosened, so the images set the motion
-  // from frame to frame while the spans hold the drift.
+  // accumulating increments; for an odometry whose error is per-frame
+  // jitter, span priors hold the drift while loosened per-step priors let
+  // the images set the motion (figures: docs/benchmarks.md).
   int span_poses = 0;
   // Rotation sigma of a span prior (per axis, degrees). Fixed, not grown
   // with the span's length: set it to the drift expected over a span.
@@ -60,14 +57,10 @@ struct BundleAdjustmentOptions {
   // span's odometry translation, plus translation_sigma_floor_m.
   double span_translation_sigma_fraction = 0.05;
   // Refine the distortion coefficients (k1, k2, p1, p2, k3) with the poses
-  // and points. A calibration that is off at the image's rim pulls the
-  // poses: on desk_vamr_a, tracks seen at > 240 px from the centre land up
-  // to 1.2 px outward of where the shipped calibration puts them (poses
-  // from the checkerboard), and the adjusted orientations wander by
-  // 0.26 deg against the checkerboard's. Off by default: there it
-  // straightens the trajectory (0.226 -> 0.166 deg against the ground
-  // truth) but moves the desk plane 2.4 mm; a calibration refitted on board
-  // views (`monomap calibrate`) is the better fix.
+  // and points, for a calibration that is off at the image's rim. Off by
+  // default: it straightens the trajectory but moves the structure; a
+  // calibration refitted on board views (`monomap calibrate`) is the better
+  // fix (figures: docs/benchmarks.md).
   bool refine_distortion = false;
   // Hold the first pose fixed (gauge). If false, the first pose gets an
   // absolute prior with the floor sigmas instead.
@@ -80,17 +73,17 @@ struct BundleAdjustmentOptions {
   int max_points = 3000;
   // Largest Levenberg-Marquardt iterations.
   int max_num_iterations = 50;
-  // Ceres stops when the relative cost decrease is below this. The cost
-  // flattens after 2-4 iterations on drifting odometry; a tighter value
-  // costs iterations that move poses by micrometres.
+  // Ceres stops when the relative cost decrease is below this: the cost
+  // flattens after a few iterations on drifting odometry, and a tighter
+  // value costs iterations that move poses by micrometres.
   double function_tolerance = 1e-4;
   // Threads Ceres uses for Jacobians and the linear solver.
   int num_threads = 1;
   // Up to this many poses the reduced camera system is solved densely
-  // (DENSE_SCHUR): faster while it is small (desk, 101 keyframes: 1.9 s ->
-  // 1.1 s). Beyond, the block-sparse solver: the system is banded (tracks
-  // span tens of frames), so its cost grows linearly with the sequence,
-  // the dense one's cubically.
+  // (DENSE_SCHUR), which is faster while it is small. Beyond, the
+  // block-sparse solver: the system is banded (tracks span tens of frames),
+  // so its cost grows linearly with the sequence, the dense one's cubically
+  // (timings: docs/benchmarks.md).
   int dense_schur_max_poses = 150;
   // Always use ITERATIVE_SCHUR (preconditioned CG): for very long
   // sequences where the reduced camera system gets large.
@@ -99,15 +92,13 @@ struct BundleAdjustmentOptions {
   // seen by more than this many frames on average over their observations
   // (sum k^2 / sum k for points seen k times): forming the dense Schur
   // complement costs a 6x6 block product per pair of observations of a
-  // point, a CG iteration one per observation. Desk (101 keyframes, 65):
-  // linear solver 0.95 -> 0.74 s, the same final cost; simulated hallway
-  // (68 keyframes, 30): dense is as fast or faster. <= 0: never.
+  // point, a CG iteration one per observation (timings:
+  // docs/benchmarks.md). <= 0: never.
   double iterative_schur_min_covisibility = 40.0;
   // CG stops when its residual falls below this fraction of the right-hand
   // side (Ceres' eta). Ceres' default 0.1 leaves the weakly constrained
-  // directions (scale, held by the priors alone) unconverged: on the
-  // 300-frame synthetic benchmark, points 5.3 mm off instead of the direct
-  // solvers' 1.4 mm; 1e-3 reaches the direct solution.
+  // directions (scale, held by the priors alone) unconverged; 1e-3 reaches
+  // the direct solvers' solution (docs/benchmarks.md).
   double iterative_schur_eta = 1e-3;
   // After adjustment, landmarks whose mean reprojection error (raw px)
   // exceeds this are dropped (same meaning and default as

@@ -1,23 +1,20 @@
 #include "monomap/triangulation/bundle_adjustment.h"
 
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <random>
 
-#include <gtest/gtest.h>
-
-#include "monomap/triangulation/synthetic_scene.h"
+#include "monomap/sim/synthetic_scene.h"
 #include "monomap/triangulation/triangulator.h"
+#include "monomap/util/angles.h"
 #include "monomap/util/error.h"
+#include "monomap/util/stats.h"
 
 namespace monomap {
 namespace {
-
-double Median(std::vector<double> v) {
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
-}
 
 struct Errors {
   double median_point_m = 0.0;
@@ -49,15 +46,14 @@ Errors Compare(const SyntheticScene& scene,
     raw.push_back((l.x_in_world - truth).norm());
     scaled.push_back((c0 + s * (l.x_in_world - c0) - truth).norm());
   }
-  e.median_point_m = Median(raw);
-  e.median_point_scaled_m = Median(scaled);
+  e.median_point_m = UpperMedian(raw);
+  e.median_point_scaled_m = UpperMedian(scaled);
   for (size_t i = 0; i < world_from_cam.size(); ++i) {
     e.mean_position_m +=
         (world_from_cam[i].translation - scene.world_from_cam[i].translation)
             .norm();
-    e.mean_rotation_deg += AngleBetween(world_from_cam[i].rotation,
-                                        scene.world_from_cam[i].rotation) *
-                           180.0 / M_PI;
+    e.mean_rotation_deg += RadToDeg(AngleBetween(
+        world_from_cam[i].rotation, scene.world_from_cam[i].rotation));
   }
   e.mean_position_m /= world_from_cam.size();
   e.mean_rotation_deg /= world_from_cam.size();
@@ -138,7 +134,7 @@ double MedianStepRotationErrorDeg(const SyntheticScene& scene,
     errors.push_back(AngleBetween(step.rotation, truth.rotation) * 180.0 /
                      M_PI);
   }
-  return Median(errors);
+  return UpperMedian(errors);
 }
 
 // Odometry whose error is mostly per-frame jitter that does not accumulate
@@ -151,7 +147,7 @@ TEST(BundleAdjustmentTest, SpanPriorsLetTheImagesRemoveOdometryJitter) {
   std::vector<Rigid3d> odometry =
       SimulateOdometryDrift(scene.world_from_cam, OdometryDriftOptions());
   std::mt19937_64 rng(5);
-  std::normal_distribution<double> jitter(0.0, 0.05 * M_PI / 180.0);
+  std::normal_distribution<double> jitter(0.0, DegToRad(0.05));
   for (size_t i = 1; i < odometry.size(); ++i) {
     const Eigen::Vector3d w(jitter(rng), jitter(rng), jitter(rng));
     odometry[i] = odometry[i] * Rigid3d(QuaternionFromRotationVector(w),

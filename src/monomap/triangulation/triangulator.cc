@@ -1,24 +1,24 @@
 #include "monomap/triangulation/triangulator.h"
 
+#include <ceres/jet.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
 
-#include <ceres/jet.h>
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-#include <Eigen/Cholesky>
-
 #include "monomap/geometry/triangulation.h"
 #include "monomap/triangulation/projection.h"
+#include "monomap/util/angles.h"
 #include "monomap/util/error.h"
 #include "monomap/util/progress.h"
+#include "monomap/util/stats.h"
 
 namespace monomap {
 namespace {
-
-constexpr double kRadToDeg = 180.0 / M_PI;
 
 enum class Outcome : uint8_t {
   kAccepted,
@@ -168,8 +168,7 @@ PointStatistics EvaluatePoint(const Camera& camera,
   const double n = std::max<size_t>(1, track.observations.size());
   s.mean_error_px = sum_error / n;
   s.mean_distance_m = sum_distance / n;
-  s.triangulation_angle_deg =
-      MaxTriangulationAngle(cams, x_in_world) * kRadToDeg;
+  s.triangulation_angle_deg = RadToDeg(MaxTriangulationAngle(cams, x_in_world));
   std::vector<Eigen::Vector2d> observed;
   observed.reserve(track.observations.size());
   for (const Observation& obs : track.observations) observed.push_back(obs.px);
@@ -186,15 +185,9 @@ PointStatistics EvaluatePoint(const Camera& camera,
   return s;
 }
 
-TriangulationReport TriangulateTracks(const Camera& camera,
-                                      const std::vector<Rigid3d>& world_from_cam,
-                                      const std::vector<Track>& tracks,
-                                      const TriangulationOptions& options,
-                                      std::vector<Landmark>* landmarks) {
-  options.Check();
-  camera.Check();
-  const Timer timer;
-  const int num_frames = static_cast<int>(world_from_cam.size());
+namespace {
+
+void CheckTrackFrames(const std::vector<Track>& tracks, int num_frames) {
   for (const Track& track : tracks) {
     for (const Observation& obs : track.observations) {
       if (obs.frame < 0 || obs.frame >= num_frames) {
@@ -205,6 +198,81 @@ TriangulationReport TriangulateTracks(const Camera& camera,
       }
     }
   }
+}
+
+// Buffers one thread reuses from track to track.
+struct TrackScratch {
+  std::vector<Rigid3d> cams;
+  std::vector<Eigen::Vector2d> normalized, observed;
+};
+
+// Triangulates one track: linear estimate, cheirality, refinement, then
+// the acceptance tests; *landmark is filled if accepted.
+Outcome TriangulateTrack(const Camera& camera,
+                         const internal::Intrinsics& intrinsics,
+                         const std::vector<Rigid3d>& cams_from_world,
+                         const Track& track,
+                         const TriangulationOptions& options,
+                         TrackScratch* scratch, Landmark* landmark) {
+  const int n = static_cast<int>(track.observations.size());
+  if (n < options.min_track_length) return Outcome::kShort;
+  std::vector<Rigid3d>& cams = scratch->cams;
+  cams.clear();
+  scratch->normalized.clear();
+  scratch->observed.clear();
+  for (const Observation& obs : track.observations) {
+    cams.push_back(cams_from_world[obs.frame]);
+    scratch->normalized.push_back(camera.NormalizedFromImage(obs.px));
+    scratch->observed.push_back(obs.px);
+  }
+  Eigen::Vector3d x;
+  if (!TriangulateLinear(cams, scratch->normalized, &x)) {
+    return Outcome::kFailed;
+  }
+  // Cheirality of the linear estimate first: refining a point behind the
+  // cameras would only chase a mirrored solution.
+  for (const Rigid3d& cam : cams) {
+    if (DepthInCamera(cam, x) < options.min_depth_m) {
+      return Outcome::kCheirality;
+    }
+  }
+  if (options.nonlinear_refinement) {
+    RefinePointLm(intrinsics, cams, scratch->observed, options, &x);
+  }
+  if (!x.allFinite()) return Outcome::kFailed;
+  const PointStatistics s = EvaluatePoint(camera, cams_from_world, track, x);
+  if (s.min_depth_m < options.min_depth_m ||
+      s.max_depth_m > options.max_depth_m) {
+    return Outcome::kCheirality;
+  }
+  if (s.triangulation_angle_deg < options.min_triangulation_angle_deg) {
+    return Outcome::kAngle;
+  }
+  if (s.mean_error_px > options.max_reprojection_error_px ||
+      s.max_error_px > options.max_observation_error_px) {
+    return Outcome::kReprojection;
+  }
+  landmark->id = track.id;
+  landmark->x_in_world = x;
+  landmark->num_observations = n;
+  landmark->mean_reprojection_error_px = s.mean_error_px;
+  landmark->triangulation_angle_deg = s.triangulation_angle_deg;
+  landmark->mean_depth_m = s.mean_distance_m;
+  landmark->covariance_m2_per_px2 = s.covariance_m2_per_px2;
+  return Outcome::kAccepted;
+}
+
+}  // namespace
+
+TriangulationReport TriangulateTracks(const Camera& camera,
+                                      const std::vector<Rigid3d>& world_from_cam,
+                                      const std::vector<Track>& tracks,
+                                      const TriangulationOptions& options,
+                                      std::vector<Landmark>* landmarks) {
+  options.Check();
+  camera.Check();
+  const Timer timer;
+  CheckTrackFrames(tracks, static_cast<int>(world_from_cam.size()));
   std::vector<Rigid3d> cams_from_world(world_from_cam.size());
   for (size_t i = 0; i < world_from_cam.size(); ++i) {
     cams_from_world[i] = world_from_cam[i].Inverse();
@@ -213,75 +281,15 @@ TriangulationReport TriangulateTracks(const Camera& camera,
 
   std::vector<Outcome> outcomes(tracks.size(), Outcome::kFailed);
   std::vector<Landmark> candidates(tracks.size());
-  tbb::parallel_for(
-      tbb::blocked_range<size_t>(0, tracks.size(), 64),
-      [&](const tbb::blocked_range<size_t>& range) {
-        std::vector<Rigid3d> cams;
-        std::vector<Eigen::Vector2d> normalized, observed;
-        for (size_t t = range.begin(); t != range.end(); ++t) {
-          const Track& track = tracks[t];
-          const int n = static_cast<int>(track.observations.size());
-          if (n < options.min_track_length) {
-            outcomes[t] = Outcome::kShort;
-            continue;
-          }
-          cams.clear();
-          normalized.clear();
-          observed.clear();
-          for (const Observation& obs : track.observations) {
-            cams.push_back(cams_from_world[obs.frame]);
-            normalized.push_back(camera.NormalizedFromImage(obs.px));
-            observed.push_back(obs.px);
-          }
-          Eigen::Vector3d x;
-          if (!TriangulateLinear(cams, normalized, &x)) {
-            outcomes[t] = Outcome::kFailed;
-            continue;
-          }
-          // Cheirality of the linear estimate first: refining a point
-          // behind the cameras would only chase a mirrored solution.
-          bool in_front = true;
-          for (const Rigid3d& cam : cams) {
-            if (DepthInCamera(cam, x) < options.min_depth_m) {
-              in_front = false;
-              break;
-            }
-          }
-          if (!in_front) {
-            outcomes[t] = Outcome::kCheirality;
-            continue;
-          }
-          if (options.nonlinear_refinement) {
-            RefinePointLm(intrinsics, cams, observed, options, &x);
-          }
-          if (!x.allFinite()) {
-            outcomes[t] = Outcome::kFailed;
-            continue;
-          }
-          const PointStatistics s =
-              EvaluatePoint(camera, cams_from_world, track, x);
-          if (s.min_depth_m < options.min_depth_m ||
-              s.max_depth_m > options.max_depth_m) {
-            outcomes[t] = Outcome::kCheirality;
-          } else if (s.triangulation_angle_deg <
-                     options.min_triangulation_angle_deg) {
-            outcomes[t] = Outcome::kAngle;
-          } else if (s.mean_error_px > options.max_reprojection_error_px ||
-                     s.max_error_px > options.max_observation_error_px) {
-            outcomes[t] = Outcome::kReprojection;
-          } else {
-            outcomes[t] = Outcome::kAccepted;
-            Landmark& l = candidates[t];
-            l.id = track.id;
-            l.x_in_world = x;
-            l.num_observations = n;
-            l.mean_reprojection_error_px = s.mean_error_px;
-            l.triangulation_angle_deg = s.triangulation_angle_deg;
-            l.mean_depth_m = s.mean_distance_m;
-            l.covariance_m2_per_px2 = s.covariance_m2_per_px2;
-          }
-        }
-      });
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, tracks.size(), 64),
+                    [&](const tbb::blocked_range<size_t>& range) {
+                      TrackScratch scratch;
+                      for (size_t t = range.begin(); t != range.end(); ++t) {
+                        outcomes[t] = TriangulateTrack(
+                            camera, intrinsics, cams_from_world, tracks[t],
+                            options, &scratch, &candidates[t]);
+                      }
+                    });
 
   TriangulationReport report;
   report.num_tracks = static_cast<int>(tracks.size());
@@ -305,9 +313,7 @@ TriangulationReport TriangulateTracks(const Camera& camera,
     double sum = 0.0;
     for (double e : errors) sum += e;
     report.mean_reprojection_error_px = sum / errors.size();
-    std::nth_element(errors.begin(), errors.begin() + errors.size() / 2,
-                     errors.end());
-    report.median_reprojection_error_px = errors[errors.size() / 2];
+    report.median_reprojection_error_px = UpperMedian(std::move(errors));
   }
   report.seconds = timer.ElapsedSeconds();
   return report;

@@ -1,22 +1,18 @@
 #include "monomap/triangulation/triangulator.h"
 
-#include <algorithm>
-#include <random>
+#include <gtest/gtest.h>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
-#include <gtest/gtest.h>
+#include <algorithm>
+#include <random>
 
-#include "monomap/triangulation/synthetic_scene.h"
+#include "monomap/sim/synthetic_scene.h"
 #include "monomap/util/error.h"
+#include "monomap/util/stats.h"
 
 namespace monomap {
 namespace {
-
-double Median(std::vector<double> v) {
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
-}
 
 TEST(TriangulatorTest, ExactObservationsGiveExactPoints) {
   SyntheticSceneOptions scene_options;
@@ -135,7 +131,7 @@ TEST(TriangulatorTest, NoisyTracksWithOutliersAndDegenerateCases) {
     const Eigen::Vector3d& truth = scene.points[l.id];
     relative_errors.push_back((l.x_in_world - truth).norm() / l.mean_depth_m);
   }
-  const double median = Median(relative_errors);
+  const double median = UpperMedian(relative_errors);
   EXPECT_LT(median, 0.005);
   EXPECT_GT(median, 0.0002);  // the noise is really there
 }
@@ -170,9 +166,9 @@ TEST(TriangulatorTest, CovarianceMatchesTheActualErrors) {
   mean /= mahalanobis2.size();
   EXPECT_GT(mean, 2.4);
   EXPECT_LT(mean, 3.8);
-  EXPECT_GT(Median(mahalanobis2), 1.8);
-  EXPECT_LT(Median(mahalanobis2), 3.0);
-  EXPECT_GT(Median(anisotropy), 5.0);  // measured 19
+  EXPECT_GT(UpperMedian(mahalanobis2), 1.8);
+  EXPECT_LT(UpperMedian(mahalanobis2), 3.0);
+  EXPECT_GT(UpperMedian(anisotropy), 5.0);  // measured 19
 }
 
 TEST(TriangulatorTest, LinearOnlyIsWorseThanRefined) {

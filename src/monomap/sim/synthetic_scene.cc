@@ -1,14 +1,13 @@
-#include "monomap/triangulation/synthetic_scene.h"
+#include "monomap/sim/synthetic_scene.h"
 
 #include <algorithm>
 #include <cmath>
 #include <random>
 
+#include "monomap/util/angles.h"
 #include "monomap/util/error.h"
 
 namespace monomap {
-
-constexpr double kDegToRad = M_PI / 180.0;
 
 Camera SyntheticCamera() {
   Camera c;
@@ -40,8 +39,8 @@ SyntheticScene MakeSyntheticScene(const SyntheticSceneOptions& options) {
                                  0.003 * std::cos(0.7 * phase));
     const Eigen::Quaterniond rotation =
         QuaternionFromRotationVector(Eigen::Vector3d(
-            1.5 * kDegToRad * std::sin(0.5 * phase),
-            3.0 * kDegToRad * std::sin(phase), 1.0 * kDegToRad * std::cos(phase)));
+            DegToRad(1.5) * std::sin(0.5 * phase),
+            DegToRad(3.0) * std::sin(phase), DegToRad(1.0) * std::cos(phase)));
     scene.world_from_cam.emplace_back(rotation, center);
   }
   std::uniform_real_distribution<double> uniform(0.0, 1.0);
@@ -95,8 +94,8 @@ std::vector<Rigid3d> SimulateOdometryDrift(
         options.translation_noise_fraction * step *
             Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
     const Eigen::Vector3d w =
-        drift_axis * options.rotation_drift_deg_per_m * step * kDegToRad +
-        options.rotation_noise_deg * kDegToRad *
+        drift_axis * DegToRad(options.rotation_drift_deg_per_m * step) +
+        DegToRad(options.rotation_noise_deg) *
             Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
     const Rigid3d noisy(delta.rotation * QuaternionFromRotationVector(w), t);
     odometry.push_back(odometry.back() * noisy);

@@ -1,7 +1,7 @@
-// Synthetic track/pose scenes with known truth, for the tests and the
-// benchmark of this module: a camera sliding sideways in front of random
-// points, KLT-like tracks of raw distorted pixels, and odometry with a
-// realistic drift.
+// Synthetic track/pose scenes with known truth, for the triangulation and
+// evaluation tests and benchmarks: a camera sliding sideways in front of
+// random points, KLT-like tracks of raw distorted pixels, and odometry with
+// a realistic drift. (Textured-plane scenes: textured_plane_scene.h.)
 #pragma once
 
 #include <cstdint>

@@ -1,0 +1,107 @@
+// monomap eval structure MAP_DIR --structure STRUCTURE_DIR
+//     [--align none|first-pose --groundtruth GT.txt] [--json OUT.json]
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+
+#include "monomap/eval/report_json.h"
+#include "monomap/eval/structure_accuracy.h"
+#include "monomap/eval/trajectory_metrics.h"
+#include "monomap/exe/eval_commands.h"
+#include "monomap/io/feature_table.h"
+#include "monomap/io/map_format.h"
+#include "monomap/io/trajectory_io.h"
+#include "monomap/util/error.h"
+
+namespace monomap {
+
+namespace {
+
+struct StructureArgs {
+  std::string map_dir, structure_dir, align = "none", groundtruth, json;
+  StructureAccuracyOptions options;  // the project's matching thresholds
+};
+
+void CheckAlignmentArgs(const StructureArgs& a) {
+  const bool first_pose = a.align == "first-pose";
+  if (first_pose && a.groundtruth.empty()) {
+    throw OptionsError(
+        "eval structure: --align first-pose needs --groundtruth");
+  }
+  if (!first_pose && !a.groundtruth.empty()) {
+    throw OptionsError(
+        "eval structure: --groundtruth is only used with --align first-pose");
+  }
+}
+
+// Relative point errors divide by each landmark's mean depth, which
+// points.ply does not hold: recompute it from the feature table. Returns
+// false (depth: distance to the nearest camera) if the map has none.
+bool SetDepthsFromFeatures(const std::string& map_dir, Map* map) {
+  const std::filesystem::path features =
+      std::filesystem::path(map_dir) / "features.csv";
+  std::error_code ec;  // a loop or a FIFO: no features, not a throw
+  const bool have_features = std::filesystem::is_regular_file(features, ec);
+  if (!have_features) {
+    std::fprintf(stderr,
+                 "monomap: note: %s missing: relative point errors use "
+                 "the distance to the nearest camera\n",
+                 features.string().c_str());
+  }
+  SetLandmarkDepths(
+      have_features ? ReadFeatureTable(features) : std::vector<Track>(), map);
+  return have_features;
+}
+
+void RunEvalStructure(const StructureArgs& a) {
+  CheckAlignmentArgs(a);
+  Map map = ReadMap(a.map_dir);
+  const Map truth = ReadMap(a.structure_dir);
+  const bool have_features = SetDepthsFromFeatures(a.map_dir, &map);
+  Rigid3d truth_from_map;
+  if (a.align == "first-pose") {
+    truth_from_map =
+        AlignTrajectories(map.trajectory, ReadTumTrajectory(a.groundtruth),
+                          Alignment::kFirstPose)
+            .rigid;
+  }
+  const StructureAccuracy acc =
+      EvaluateStructure(map, truth, truth_from_map, a.options);
+  nlohmann::json j = ToJson(acc);
+  j["alignment"] = a.align;
+  j["relative_error_depth"] = have_features
+                                  ? "mean_distance_to_observing_cameras"
+                                  : "distance_to_nearest_camera";
+  j["options"] = ToJson(a.options);
+  PrintOrWrite(
+      j, "structure accuracy (alignment " + a.align + ")\n" + FormatTable(acc),
+      a.json);
+}
+
+}  // namespace
+
+void RegisterEvalStructureCommand(CLI::App* eval) {
+  auto a = std::make_shared<StructureArgs>();
+  CLI::App* cmd = eval->add_subcommand(
+      "structure",
+      "Compare the map with a world's true planes (a simulated dataset's "
+      "structure/ directory): point errors, plane matches, precision and "
+      "recall");
+  cmd->add_option("map", a->map_dir, "Map directory")->required();
+  cmd->add_option("--structure", a->structure_dir,
+                  "Ground-truth structure as a map directory (the "
+                  "simulator writes DATASET/structure)")
+      ->required();
+  cmd->add_option("--align", a->align,
+                  "none: the map is in the truth's frame (the simulator's "
+                  "odometry starts at the true pose); first-pose: align "
+                  "the map's first trajectory pose to --groundtruth")
+      ->check(CLI::IsMember({"none", "first-pose"}))
+      ->capture_default_str();
+  cmd->add_option("--groundtruth", a->groundtruth,
+                  "Ground-truth trajectory (TUM) for --align first-pose");
+  cmd->add_option("--json", a->json, "Write the figures as JSON");
+  cmd->callback([a]() { RunEvalStructure(*a); });
+}
+
+}  // namespace monomap
