@@ -16,6 +16,7 @@
 #include <opencv2/core.hpp>
 
 #include "monomap/camera/camera.h"
+#include "monomap/geometry/pose2d.h"
 #include "monomap/map/map.h"
 
 namespace monomap {
@@ -35,11 +36,6 @@ struct DatasetOptions {
   std::filesystem::path camera_yaml;
 
   void Check() const;
-};
-
-// Planar robot base pose on the floor.
-struct Pose2d {
-  double x = 0, y = 0, yaw = 0;
 };
 
 struct DatasetFrame {
@@ -79,8 +75,5 @@ void WriteCameraYaml(const std::filesystem::path& path, const Camera& camera,
 Rigid3d ReadCameraMountYaml(const std::filesystem::path& path);
 void WriteCameraMountYaml(const std::filesystem::path& path,
                           const Rigid3d& base_from_cam);
-
-// world_from_cam of a camera mounted on a planar base (base z=0 on floor).
-Rigid3d WorldFromCamOfBase(const Pose2d& base, const Rigid3d& base_from_cam);
 
 }  // namespace monomap

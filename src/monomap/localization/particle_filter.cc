@@ -29,14 +29,6 @@ double WrapAngle(double a) {
   return a;
 }
 
-Pose2d BaseOfWorldFromCam(const Rigid3d& world_from_cam,
-                          const Rigid3d& base_from_cam) {
-  const Rigid3d world_from_base = world_from_cam * base_from_cam.Inverse();
-  const Eigen::Matrix3d r = world_from_base.RotationMatrix();
-  return {world_from_base.translation.x(), world_from_base.translation.y(),
-          std::atan2(r(1, 0), r(0, 0))};
-}
-
 void OdometryNoise2d::Check() const {
   CheckOption(alpha1 >= 0 && alpha2 >= 0 && alpha3 >= 0 && alpha4 >= 0,
               "odometry_noise2d.alpha", "must be >= 0");

@@ -12,7 +12,7 @@
 #include <Eigen/Core>
 
 #include "monomap/geometry/rigid3.h"
-#include "monomap/io/dataset.h"
+#include "monomap/geometry/pose2d.h"
 
 namespace monomap {
 
@@ -26,11 +26,6 @@ struct Particle {
   // Unnormalized log weight (log likelihoods add up between resamplings).
   double log_weight = 0.0;
 };
-
-// Robot base pose of a camera pose (inverse of WorldFromCamOfBase): the
-// base frame's x, y and yaw; its height, roll and pitch are dropped.
-Pose2d BaseOfWorldFromCam(const Rigid3d& world_from_cam,
-                          const Rigid3d& base_from_cam);
 
 // Wraps an angle to (-pi, pi].
 double WrapAngle(double a);

@@ -269,15 +269,5 @@ TEST(Particles, WeightedMeanPoseIgnoresQuaternionSign) {
   EXPECT_NEAR(RotationVectorFromQuaternion(m2.rotation).z(), 0.05, 2e-3);
 }
 
-TEST(Particles, BaseRoundTrip) {
-  const Rigid3d mount(QuaternionFromRotationVector({-1.9, 0.1, -0.05}),
-                      {0.1, 0.02, 0.5});
-  const Pose2d b{1.5, -0.7, 2.9};
-  const Pose2d back = BaseOfWorldFromCam(WorldFromCamOfBase(b, mount), mount);
-  EXPECT_NEAR(back.x, b.x, 1e-12);
-  EXPECT_NEAR(back.y, b.y, 1e-12);
-  EXPECT_NEAR(WrapAngle(back.yaw - b.yaw), 0.0, 1e-12);
-}
-
 }  // namespace
 }  // namespace monomap
