@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include "monomap/localization/state_model.h"
+
 namespace monomap {
 namespace {
 
@@ -192,7 +194,10 @@ TEST(Kld, ResampleCountGrowsWithSpread) {
     }
     const std::vector<double> w(ps.size(), 1.0);
     int bins = 0;
-    const std::vector<int> idx = KldResample(ps, w, o, true, &rng, &bins);
+    const PlanarStateModel planar{Rigid3d(), OdometryNoise2d()};
+    const std::vector<int> idx = KldResample(
+        ps, w, o, [&](const Particle& p) { return planar.Bin(p, o); }, &rng,
+        &bins);
     // The count is the bound of the bins seen (or the minimum).
     EXPECT_GE(static_cast<double>(idx.size()),
               std::min<double>(o.max_particles,
