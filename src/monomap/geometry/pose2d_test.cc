@@ -50,9 +50,9 @@ TEST(Pose2d, BaseOfWorldFromCamDropsHeightAndTilt) {
   EXPECT_NEAR(back.x, b.x, 1e-12);
   EXPECT_NEAR(back.y, b.y, 1e-12);
   EXPECT_NEAR(back.yaw, b.yaw, 1e-12);
-  const Rigid3d pitched(lifted.rotation * QuaternionFromRotationVector(
-                                              {5.0 * M_PI / 180, 0, 0}),
-                        lifted.translation);
+  const Rigid3d pitched(
+      lifted.rotation * QuaternionFromRotationVector({5.0 * M_PI / 180, 0, 0}),
+      lifted.translation);
   EXPECT_NEAR(BaseOfWorldFromCam(pitched, mount).yaw, b.yaw, 1e-9);
 }
 

@@ -4,9 +4,8 @@
 // refinement's.
 #pragma once
 
-#include <optional>
-
 #include <opencv2/core.hpp>
+#include <optional>
 
 #include "monomap/localization/measurement_model.h"
 

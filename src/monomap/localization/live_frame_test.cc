@@ -25,8 +25,7 @@ TEST(LiveFrame, PreparesEachAskedSizeOnce) {
   EXPECT_EQ(live.correction().size(), cv::Size(160, 120));
   EXPECT_TRUE(live.refinement().empty());
   // The measurement image is the model's own preparation, pixel for pixel.
-  EXPECT_EQ(cv::norm(live.measurement(), model.PrepareLive(raw),
-                     cv::NORM_INF),
+  EXPECT_EQ(cv::norm(live.measurement(), model.PrepareLive(raw), cv::NORM_INF),
             0.0);
   // A raw image of another size is refused.
   EXPECT_THROW(LiveFrame(cv::Mat(10, 10, CV_8UC1, cv::Scalar(0)),

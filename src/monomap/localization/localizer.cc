@@ -101,8 +101,9 @@ SamplingArea AreaOf(const Map& map, const InitializationOptions& options) {
     }
   }
   if (!(lo.x() <= hi.x())) {
-    throw InputError("localization: the map has neither trajectory nor "
-                     "plane polygons to bound the area");
+    throw InputError(
+        "localization: the map has neither trajectory nor "
+        "plane polygons to bound the area");
   }
   return {lo.array() - options.area_margin_m,
           hi.array() + options.area_margin_m};
@@ -125,10 +126,10 @@ Localizer::Localizer(const Map& map, const Camera& camera,
       renderer_((options.Check(), map), options.renderer),
       measurement_(&renderer_, camera, options.mcl.measurement),
       state_(MakeStateModel(map, options, base_from_cam)),
-      correction_(options.method == LocalizationMethod::kMcc
-                      ? std::make_unique<MccCorrection>(&renderer_, camera,
-                                                        options.mcc)
-                      : nullptr),
+      correction_(
+          options.method == LocalizationMethod::kMcc
+              ? std::make_unique<MccCorrection>(&renderer_, camera, options.mcc)
+              : nullptr),
       recovery_(options.recovery, options.method == LocalizationMethod::kMcc,
                 options.mcl.num_particles, options.mcl.measurement.sigma),
       map_has_trajectory_(!map.trajectory.empty()),

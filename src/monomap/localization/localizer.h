@@ -7,13 +7,12 @@
 // predict -> weigh -> correct -> estimate -> recover -> resample.
 #pragma once
 
+#include <Eigen/Core>
 #include <memory>
+#include <opencv2/core.hpp>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
-#include <opencv2/core.hpp>
 
 #include "monomap/localization/live_frame.h"
 #include "monomap/localization/mcc_correction.h"
@@ -98,10 +97,10 @@ struct LocalizerOptions {
 };
 
 struct LocalizerStepStats {
-  int particles = 0;         // after resampling (or merging)
+  int particles = 0;          // after resampling (or merging)
   int particles_weighed = 0;  // rendered this step
-  double ess = 0.0;          // before resampling
-  double max_weight = 0.0;   // normalized, before resampling
+  double ess = 0.0;           // before resampling
+  double max_weight = 0.0;    // normalized, before resampling
   double best_ncc = 0.0;
   double cluster_weight = 0.0;  // weight share of the estimate's cluster
   int kld_bins = 0;
@@ -110,7 +109,7 @@ struct LocalizerStepStats {
   int mcc_attempted = 0;
   int mcc_accepted = 0;
   int merged = 0;
-  bool refined = false;      // the estimate was refined (refine_estimate)
+  bool refined = false;  // the estimate was refined (refine_estimate)
   bool resampled = false;
   double weigh_seconds = 0.0;  // rendering + NCC of every particle
   double mcc_seconds = 0.0;    // corrections (MCC only), refinement included

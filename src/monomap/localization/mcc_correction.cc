@@ -49,8 +49,8 @@ MccCorrection::MccCorrection(const Renderer* renderer, const Camera& camera,
 
 void MccCorrection::AddSizes(LiveFrameSizes* sizes) const {
   if (options_.top_k > 0) {
-    sizes->correction = ImageSize{options_.corrector.width,
-                                  options_.corrector.height};
+    sizes->correction =
+        ImageSize{options_.corrector.width, options_.corrector.height};
   }
   if (options_.refine_estimate) {
     sizes->refinement =
@@ -64,9 +64,9 @@ MccCorrectionStats MccCorrection::CorrectParticles(
     std::vector<MeasurementScore>* scores) const {
   MccCorrectionStats stats;
   if (options_.top_k <= 0) return stats;
-  const std::vector<size_t> order = SpreadHeaviest(
-      *particles, static_cast<size_t>(options_.top_k), options_.spread_m,
-      options_.spread_deg * kDegToRad);
+  const std::vector<size_t> order =
+      SpreadHeaviest(*particles, static_cast<size_t>(options_.top_k),
+                     options_.spread_m, options_.spread_deg * kDegToRad);
   const size_t k = order.size();
   std::vector<int> accepted(k, 0);
   tbb::parallel_for(size_t{0}, k, [&](size_t j) {

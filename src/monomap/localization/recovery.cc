@@ -45,21 +45,20 @@ bool RecoveryEstimator::Update(double best_log_likelihood) {
 }
 
 InjectionPlan RecoveryEstimator::Plan(int resampled) const {
-  int n_inject = static_cast<int>(
-      std::lround(options_.injection_fraction * resampled));
+  int n_inject =
+      static_cast<int>(std::lround(options_.injection_fraction * resampled));
   if (with_mcc_) {
     // Never more than half the set: the resampled particles carry the
     // filter's belief.
-    n_inject = std::max(n_inject,
-                        std::min(options_.mcc_min_injected, resampled / 2));
+    n_inject =
+        std::max(n_inject, std::min(options_.mcc_min_injected, resampled / 2));
   }
   const int n_relocalize =
-      relocalizing_
-          ? static_cast<int>(std::lround(options_.relocalize_fraction * budget_))
-          : 0;
+      relocalizing_ ? static_cast<int>(
+                          std::lround(options_.relocalize_fraction * budget_))
+                    : 0;
   InjectionPlan plan;
-  plan.appended =
-      std::min(n_relocalize, std::max(0, budget_ - resampled));
+  plan.appended = std::min(n_relocalize, std::max(0, budget_ - resampled));
   plan.replaced =
       n_inject + std::min(n_relocalize - plan.appended, resampled / 2);
   return plan;

@@ -47,11 +47,14 @@ class RecoveryEstimator {
   // `with_mcc`: the set is corrected by MCC (mcc_min_injected applies).
   // `budget`: the particle budget; `sigma`: the measurement's likelihood
   // temperature. Throws OptionsError on bad options.
-  RecoveryEstimator(const RecoveryOptions& options, bool with_mcc,
-                    int budget, double sigma);
+  RecoveryEstimator(const RecoveryOptions& options, bool with_mcc, int budget,
+                    double sigma);
 
   // Forgets the averages (after an initialization).
-  void Reset() { has_average_ = false; relocalizing_ = false; }
+  void Reset() {
+    has_average_ = false;
+    relocalizing_ = false;
+  }
   // Feeds one update's best log-likelihood; returns whether the filter is
   // relocalizing (always false with relocalize_ncc_drop 0).
   bool Update(double best_log_likelihood);

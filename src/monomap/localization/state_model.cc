@@ -34,8 +34,8 @@ Particle PlanarStateModel::FromPose(const Rigid3d& world_from_cam) const {
 
 void PlanarStateModel::Predict(const OdometryIncrement& odometry, Rng* rng,
                                Particle* p) const {
-  SetBase(SampleOdometryMotion2d(p->base, odometry.base_prev,
-                                 odometry.base_cur, noise_, rng),
+  SetBase(SampleOdometryMotion2d(p->base, odometry.base_prev, odometry.base_cur,
+                                 noise_, rng),
           p);
 }
 
@@ -69,8 +69,12 @@ std::vector<Particle> PlanarStateModel::AroundPose(
 }
 
 KldBin PlanarStateModel::Bin(const Particle& p, const KldOptions& o) const {
-  return {BinOf(p.base.x, o.bin_xy_m), BinOf(p.base.y, o.bin_xy_m),
-          BinOf(WrapAngle(p.base.yaw) + M_PI, o.bin_angle_rad), 0, 0, 0};
+  return {BinOf(p.base.x, o.bin_xy_m),
+          BinOf(p.base.y, o.bin_xy_m),
+          BinOf(WrapAngle(p.base.yaw) + M_PI, o.bin_angle_rad),
+          0,
+          0,
+          0};
 }
 
 Particle SixDofStateModel::FromPose(const Rigid3d& world_from_cam) const {
@@ -94,8 +98,9 @@ Particle SixDofStateModel::Random(const SamplingArea& area,
   Rigid3d ref = reference.value_or(Rigid3d());
   if (!reference) {
     if (map_trajectory_.empty()) {
-      throw StageError("6-DoF global init needs a reference pose or a map "
-                       "trajectory for the camera height and tilt");
+      throw StageError(
+          "6-DoF global init needs a reference pose or a map "
+          "trajectory for the camera height and tilt");
     }
     std::uniform_int_distribution<size_t> pick(0, map_trajectory_.size() - 1);
     ref = map_trajectory_[pick(*rng)];
@@ -129,8 +134,8 @@ KldBin SixDofStateModel::Bin(const Particle& p, const KldOptions& o) const {
   const Eigen::Vector3d& t = p.world_from_cam.translation;
   const Eigen::Vector3d w =
       RotationVectorFromQuaternion(p.world_from_cam.rotation);
-  return {BinOf(t.x(), o.bin_xy_m),      BinOf(t.y(), o.bin_xy_m),
-          BinOf(t.z(), o.bin_z_m),       BinOf(w[0], o.bin_angle_rad),
+  return {BinOf(t.x(), o.bin_xy_m),     BinOf(t.y(), o.bin_xy_m),
+          BinOf(t.z(), o.bin_z_m),      BinOf(w[0], o.bin_angle_rad),
           BinOf(w[1], o.bin_angle_rad), BinOf(w[2], o.bin_angle_rad)};
 }
 

@@ -5,11 +5,10 @@
 // camera pose into a state, and the KLD histogram bin.
 #pragma once
 
+#include <Eigen/Core>
 #include <memory>
 #include <optional>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "monomap/geometry/pose2d.h"
 #include "monomap/geometry/rigid3.h"
@@ -50,9 +49,8 @@ class StateModel {
                           Rng* rng) const = 0;
   // `n` states around a camera pose, normal with standard deviations
   // spread_m and spread_rad (per axis with the 6-DoF state).
-  virtual std::vector<Particle> AroundPose(const Rigid3d& world_from_cam,
-                                           int n, double spread_m,
-                                           double spread_rad,
+  virtual std::vector<Particle> AroundPose(const Rigid3d& world_from_cam, int n,
+                                           double spread_m, double spread_rad,
                                            Rng* rng) const = 0;
   // The particle's cell of the KLD-sampling histogram.
   virtual KldBin Bin(const Particle& p, const KldOptions& options) const = 0;

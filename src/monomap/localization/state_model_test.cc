@@ -1,9 +1,9 @@
 #include "monomap/localization/state_model.h"
 
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 #include "monomap/util/error.h"
 
@@ -45,7 +45,8 @@ TEST(PlanarStateModel, FromPoseProjectsOntoTheFloorState) {
 
 TEST(PlanarStateModel, PredictMovesBaseAndCameraTogether) {
   const PlanarStateModel state(Mount(), NoNoise2d());
-  Particle p = state.FromPose(WorldFromCamOfBase({1.0, 1.0, M_PI / 2}, Mount()));
+  Particle p =
+      state.FromPose(WorldFromCamOfBase({1.0, 1.0, M_PI / 2}, Mount()));
   OdometryIncrement odometry;
   odometry.base_prev = {0.0, 0.0, 0.0};
   odometry.base_cur = {0.3, 0.0, 0.2};  // 0.3 m ahead, turned 0.2 rad
@@ -92,9 +93,12 @@ TEST(PlanarStateModel, RandomAndAroundPoseCoverWhatIsAsked) {
 TEST(StateModels, KldBinsFollowTheState) {
   KldOptions o;  // 5 cm, 5 degree bins
   const PlanarStateModel planar(Mount(), NoNoise2d());
-  const Particle a = planar.FromPose(WorldFromCamOfBase({0.01, 0.01, 0.01}, Mount()));
-  const Particle b = planar.FromPose(WorldFromCamOfBase({0.04, 0.02, 0.02}, Mount()));
-  const Particle c = planar.FromPose(WorldFromCamOfBase({0.07, 0.01, 0.01}, Mount()));
+  const Particle a =
+      planar.FromPose(WorldFromCamOfBase({0.01, 0.01, 0.01}, Mount()));
+  const Particle b =
+      planar.FromPose(WorldFromCamOfBase({0.04, 0.02, 0.02}, Mount()));
+  const Particle c =
+      planar.FromPose(WorldFromCamOfBase({0.07, 0.01, 0.01}, Mount()));
   EXPECT_EQ(planar.Bin(a, o), planar.Bin(b, o));
   EXPECT_NE(planar.Bin(a, o), planar.Bin(c, o));
   // Planar bins have no z, roll or pitch; 6-DoF bins tell heights apart.
@@ -112,8 +116,8 @@ TEST(SixDofStateModel, RandomKeepsTheReferenceHeightAndTilt) {
   EXPECT_THROW(no_trajectory.Random(area, std::nullopt, &rng), StageError);
   const Rigid3d ref = WorldFromCamOfBase({0.3, 0.1, 0.7}, Mount());
   const SixDofStateModel six(OdometryNoise6d(), {ref});
-  for (const std::optional<Rigid3d>& r : {std::optional<Rigid3d>(ref),
-                                          std::optional<Rigid3d>()}) {
+  for (const std::optional<Rigid3d>& r :
+       {std::optional<Rigid3d>(ref), std::optional<Rigid3d>()}) {
     const Particle p = six.Random(area, r, &rng);
     EXPECT_NEAR(p.world_from_cam.translation.z(), 0.4, 1e-12);
     const Eigen::Vector3d axis =

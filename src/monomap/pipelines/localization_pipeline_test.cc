@@ -1,11 +1,10 @@
 #include "monomap/pipelines/localization_pipeline.h"
 
+#include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
-
-#include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 
 #include "monomap/localization/test_scene.h"
@@ -29,8 +28,7 @@ class LocalizationPipelineTest : public ::testing::Test {
  protected:
   void SetUp() override {
     dir_ = std::filesystem::temp_directory_path() /
-           ("monomap_localization_pipeline_test_" +
-            std::to_string(::getpid()));
+           ("monomap_localization_pipeline_test_" + std::to_string(::getpid()));
     std::filesystem::create_directories(dir_);
     map_ = test_scene::RoomMap();
     const Camera camera = test_scene::LiveCamera();
@@ -47,8 +45,8 @@ class LocalizationPipelineTest : public ::testing::Test {
       f.image_path = dir_ / ("f" + std::to_string(i) + ".png");
       truth_.push_back(WorldFromCamOfBase(truth, mount));
       cv::imwrite(f.image_path.string(),
-                  test_scene::LiveImage(renderer, camera, truth_.back(), 0.9,
-                                        5, 2.0, i));
+                  test_scene::LiveImage(renderer, camera, truth_.back(), 0.9, 5,
+                                        2.0, i));
       f.odometry_base = odometry;
       f.odometry_world_from_cam = WorldFromCamOfBase(odometry, mount);
       f.groundtruth_world_from_cam = truth_.back();
@@ -124,8 +122,7 @@ TEST_F(LocalizationPipelineTest, TracksFromAGivenPoseAndReportsErrors) {
 
   const nlohmann::json j = r.ToJson();
   EXPECT_EQ(j["frames"].get<int>(), 10);
-  EXPECT_DOUBLE_EQ(j["rmse_translation_m"].get<double>(),
-                   r.rmse_translation_m);
+  EXPECT_DOUBLE_EQ(j["rmse_translation_m"].get<double>(), r.rmse_translation_m);
   ASSERT_EQ(j["steps"].size(), 10u);
   EXPECT_EQ(j["steps"][9]["particles"].get<int>(), r.steps[9].particles);
   EXPECT_EQ(j["steps"][9].size(), 12u);
