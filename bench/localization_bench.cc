@@ -36,9 +36,9 @@ void BM_Update(benchmark::State& state, LocalizationMethod method) {
   LocalizerOptions o;
   o.method = method;
   o.state = LocalizationState::kPlanar;
-  o.num_particles = static_cast<int>(state.range(0));
-  o.use_kld = false;  // a fixed count, to time what is asked
-  o.init_spread_m = 0.05;
+  o.mcl.num_particles = static_cast<int>(state.range(0));
+  o.mcl.use_kld = false;  // a fixed count, to time what is asked
+  o.init.spread_m = 0.05;
   Localizer loc(s.map, s.camera, o, s.mount);
   loc.InitializeAtPose(s.truth);
   OdometryIncrement odo;

@@ -38,6 +38,7 @@
 #include "monomap/io/dataset.h"
 #include "monomap/io/map_format.h"
 #include "monomap/localization/localizer.h"
+#include "monomap/pipelines/localization_pipeline.h"
 #include "monomap/pipelines/mapping_pipeline.h"
 #include "monomap/sim/simulate.h"
 #include "monomap/util/error.h"
@@ -85,7 +86,7 @@ struct SweepOptions {
   // MCC: largest rotation a correction may make (degrees; <= 0: the
   // localizer's default).
   double mcc_max_rotation_deg = 0.0;
-  // Relocalization trigger (LocalizerOptions::relocalize_*; a negative
+  // Relocalization trigger (RecoveryOptions::relocalize_*; a negative
   // value: the localizer's default).
   double relocalize_ncc_drop = -1.0;
   double relocalize_fraction = -1.0;
@@ -290,33 +291,37 @@ nlohmann::json RunSeed(const SweepOptions& o, const std::string& world,
                world.c_str(), seed, map.landmarks.size(), map.planes.size(),
                100 * map_ate.translation_m.median);
   for (size_t c = 0; c < configs.size(); ++c) {
-    LocalizerOptions lo;
+    LocalizationPipelineOptions po;
+    LocalizerOptions& lo = po.localizer;
     lo.method = configs[c].method;
     lo.state = LocalizationState::kPlanar;
-    lo.init = kidnap ? LocalizationInit::kPose : LocalizationInit::kGlobal;
-    lo.num_particles = configs[c].particles;
-    lo.use_kld = !o.fixed_count;
-    lo.kld.max_particles = configs[c].particles;
-    lo.kld.min_particles = std::min(lo.kld.min_particles, lo.num_particles);
+    lo.init.kind = kidnap ? LocalizationInit::kPose : LocalizationInit::kGlobal;
+    lo.mcl.num_particles = configs[c].particles;
+    lo.mcl.use_kld = !o.fixed_count;
+    lo.mcl.kld.max_particles = configs[c].particles;
+    lo.mcl.kld.min_particles =
+        std::min(lo.mcl.kld.min_particles, lo.mcl.num_particles);
     lo.seed = static_cast<uint64_t>(seed);
-    if (o.sigma > 0) lo.measurement.sigma = o.sigma;
-    if (o.refine_width == 0) lo.refine_estimate = false;
-    if (o.refine_width > 0) lo.refine_mcc.width = o.refine_width;
-    if (o.mcc_min_injected >= 0) lo.mcc_min_injected = o.mcc_min_injected;
+    if (o.sigma > 0) lo.mcl.measurement.sigma = o.sigma;
+    if (o.refine_width == 0) lo.mcc.refine_estimate = false;
+    if (o.refine_width > 0) lo.mcc.refinement.width = o.refine_width;
+    if (o.mcc_min_injected >= 0) {
+      lo.recovery.mcc_min_injected = o.mcc_min_injected;
+    }
     if (o.mcc_max_rotation_deg > 0) {
-      lo.mcc.max_rotation_deg = o.mcc_max_rotation_deg;
+      lo.mcc.corrector.max_rotation_deg = o.mcc_max_rotation_deg;
     }
     if (o.relocalize_ncc_drop >= 0) {
-      lo.relocalize_ncc_drop = o.relocalize_ncc_drop;
+      lo.recovery.relocalize_ncc_drop = o.relocalize_ncc_drop;
     }
     if (o.relocalize_fraction >= 0) {
-      lo.relocalize_fraction = o.relocalize_fraction;
+      lo.recovery.relocalize_fraction = o.relocalize_fraction;
     }
     if (o.relocalize_alpha_slow >= 0) {
-      lo.relocalize_alpha_slow = o.relocalize_alpha_slow;
+      lo.recovery.relocalize_alpha_slow = o.relocalize_alpha_slow;
     }
     std::vector<TimedPose> trajectory;
-    const LocalizationReport r = LocalizeSequence(map, live, lo, &trajectory);
+    const LocalizationReport r = LocalizeSequence(map, live, po, &trajectory);
     ConfigRun& run = (*runs)[c];
     run.ok = true;
     if (kidnap) {

@@ -4,14 +4,13 @@
 #include <algorithm>
 #include <cstdio>
 #include <memory>
-#include <nlohmann/json.hpp>
 
 #include "monomap/exe/cli_parse.h"
 #include "monomap/exe/commands.h"
 #include "monomap/io/dataset.h"
 #include "monomap/io/map_format.h"
 #include "monomap/io/trajectory_io.h"
-#include "monomap/localization/localizer.h"
+#include "monomap/pipelines/localization_pipeline.h"
 #include "monomap/report/html_page.h"
 #include "monomap/report/localization_run.h"
 #include "monomap/util/error.h"
@@ -89,47 +88,49 @@ void RegisterLocalizeCommand(CLI::App& app) {
     dataset_options.num_frames = a->num_frames;
     dataset_options.camera_yaml = a->camera_yaml;
     const Dataset dataset = LoadDataset(a->dataset, dataset_options);
-    LocalizerOptions options;
+    LocalizationPipelineOptions pipeline;
+    LocalizerOptions& options = pipeline.localizer;
     options.method = ParseLocalizationMethod(a->method);
-    options.init = ParseLocalizationInit(a->init);
+    options.init.kind = ParseLocalizationInit(a->init);
     options.state = ParseLocalizationState(a->state);
     if (!a->init_pose.empty()) {
-      if (options.init != LocalizationInit::kPose) {
+      if (options.init.kind != LocalizationInit::kPose) {
         throw OptionsError("--init-pose needs --init pose");
       }
-      options.init_pose = ParsePose(a->init_pose, "--init-pose");
+      options.init.pose = ParsePose(a->init_pose, "--init-pose");
     }
     // The budget: the initial count and KLD-sampling's maximum.
-    options.num_particles = a->particles;
-    options.kld.max_particles = a->particles;
-    options.kld.min_particles =
-        std::min(options.kld.min_particles, a->particles);
+    options.mcl.num_particles = a->particles;
+    options.mcl.kld.max_particles = a->particles;
+    options.mcl.kld.min_particles =
+        std::min(options.mcl.kld.min_particles, a->particles);
     if (!a->mcc_size.empty()) {
-      ParseImageSize(a->mcc_size, "--mcc-size", &options.mcc.width,
-                     &options.mcc.height);
+      ParseImageSize(a->mcc_size, "--mcc-size", &options.mcc.corrector.width,
+                     &options.mcc.corrector.height);
     }
     if (!a->measure_size.empty()) {
       ParseImageSize(a->measure_size, "--measure-size",
-                     &options.measurement.width, &options.measurement.height);
+                     &options.mcl.measurement.width,
+                     &options.mcl.measurement.height);
     }
-    if (a->mcc_top_k >= 0) options.mcc_top_k = a->mcc_top_k;
+    if (a->mcc_top_k >= 0) options.mcc.top_k = a->mcc_top_k;
     if (a->refine_width == 0) {
-      options.refine_estimate = false;
+      options.mcc.refine_estimate = false;
     } else if (a->refine_width > 0) {
       if (a->refine_width < 16) {
         throw OptionsError("--refine-width: must be 0 or at least 16");
       }
-      // The height follows the camera's aspect (RefinementOptions).
-      options.refine_mcc.width = a->refine_width;
+      // The height follows the camera's aspect (MccCorrection).
+      options.mcc.refinement.width = a->refine_width;
     }
     if (a->relocalize_ncc_drop >= 0) {
-      options.relocalize_ncc_drop = a->relocalize_ncc_drop;
+      options.recovery.relocalize_ncc_drop = a->relocalize_ncc_drop;
     }
     options.seed = a->seed;
     std::vector<TimedPose> trajectory;
     std::vector<std::vector<Particle>> sets;
     const LocalizationReport r = LocalizeSequence(
-        map, dataset, options, &trajectory,
+        map, dataset, pipeline, &trajectory,
         a->particles_out.empty() && a->html.empty() ? nullptr : &sets);
     WriteTumTrajectory(a->output, trajectory,
                        "monomap localize --method " + a->method);
@@ -151,36 +152,9 @@ void RegisterLocalizeCommand(CLI::App& app) {
       }
       WriteFileAtomic(a->particles_out, csv);
     }
-    nlohmann::json j;
-    j["frames"] = r.frames;
-    j["seconds"] = r.seconds;
-    j["mean_step_seconds"] = r.mean_step_seconds;
-    j["mean_particles"] = r.mean_particles;
-    j["mcc_accepted"] = r.mcc_accepted;
-    if (r.has_errors) {
-      j["rmse_translation_m"] = r.rmse_translation_m;
-      j["mean_rotation_error_deg"] = r.mean_rotation_error_deg;
-      j["final_translation_error_m"] = r.final_translation_error_m;
-      j["final_rotation_error_deg"] = r.final_rotation_error_deg;
-      j["fraction_within_10cm"] = r.fraction_within_10cm;
+    if (!a->report.empty()) {
+      WriteFileAtomic(a->report, r.ToJson().dump(2) + "\n");
     }
-    nlohmann::json steps = nlohmann::json::array();
-    for (const auto& s : r.steps) {
-      steps.push_back({{"particles", s.particles},
-                       {"ess", s.ess},
-                       {"best_ncc", s.best_ncc},
-                       {"mcc_accepted", s.mcc_accepted},
-                       {"merged", s.merged},
-                       {"injected", s.injected},
-                       {"relocalizing", s.relocalizing},
-                       {"particles_weighed", s.particles_weighed},
-                       {"refined", s.refined},
-                       {"weigh_seconds", s.weigh_seconds},
-                       {"mcc_seconds", s.mcc_seconds},
-                       {"seconds", s.seconds}});
-    }
-    j["steps"] = steps;
-    if (!a->report.empty()) WriteFileAtomic(a->report, j.dump(2) + "\n");
     if (!a->html.empty()) {
       // The run as `monomap report --localization` would read it back.
       ReportInputs in;
@@ -198,7 +172,7 @@ void RegisterLocalizeCommand(CLI::App& app) {
       }
       run.particles =
           ParticlePositions(sets, ReportOptions().max_particles_per_step);
-      run.report = j;
+      run.report = r.ToJson();
       in.localization.push_back(std::move(run));
       ThrowIfProblems(WriteReport(in, a->html), a->html);
     }

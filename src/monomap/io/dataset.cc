@@ -296,12 +296,6 @@ void WriteCameraMountYaml(const fs::path& path, const Rigid3d& base_from_cam) {
   WriteFileAtomic(path, out.str());
 }
 
-Rigid3d WorldFromCamOfBase(const Pose2d& base, const Rigid3d& base_from_cam) {
-  const Rigid3d world_from_base(YawRotation(base.yaw),
-                                Eigen::Vector3d(base.x, base.y, 0.0));
-  return world_from_base * base_from_cam;
-}
-
 Dataset LoadDataset(const fs::path& root, const DatasetOptions& options) {
   options.Check();
   std::error_code ec;

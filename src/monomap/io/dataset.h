@@ -16,6 +16,7 @@
 #include <opencv2/core.hpp>
 
 #include "monomap/camera/camera.h"
+#include "monomap/geometry/pose2d.h"
 #include "monomap/map/map.h"
 
 namespace monomap {
@@ -49,11 +50,6 @@ struct DatasetOptions {
 // beyond is refused as corrupt.
 inline constexpr double kMaxOdometryTranslationM = 1e4;
 inline constexpr double kMaxOdometryYawRad = 1e4;  // unwrapped yaw
-
-// Planar robot base pose on the floor.
-struct Pose2d {
-  double x = 0, y = 0, yaw = 0;
-};
 
 struct DatasetFrame {
   double timestamp = 0.0;
@@ -94,8 +90,5 @@ void WriteCameraYaml(const std::filesystem::path& path, const Camera& camera,
 Rigid3d ReadCameraMountYaml(const std::filesystem::path& path);
 void WriteCameraMountYaml(const std::filesystem::path& path,
                           const Rigid3d& base_from_cam);
-
-// world_from_cam of a camera mounted on a planar base (base z=0 on floor).
-Rigid3d WorldFromCamOfBase(const Pose2d& base, const Rigid3d& base_from_cam);
 
 }  // namespace monomap

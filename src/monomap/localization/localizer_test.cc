@@ -3,12 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
-
-#include <unistd.h>
 
 #include <gtest/gtest.h>
-#include <opencv2/imgcodecs.hpp>
 
 #include "monomap/localization/test_scene.h"
 #include "monomap/util/error.h"
@@ -100,10 +96,10 @@ TEST_F(LocalizerTest, PlanarMclTracksFromAPose) {
   LocalizerOptions o;
   o.method = LocalizationMethod::kMcl;
   o.state = LocalizationState::kPlanar;
-  o.num_particles = 500;
-  o.kld.max_particles = 500;
-  o.init_spread_m = 0.05;
-  o.injection_fraction = 0.0;
+  o.mcl.num_particles = 500;
+  o.mcl.kld.max_particles = 500;
+  o.init.spread_m = 0.05;
+  o.recovery.injection_fraction = 0.0;
   o.seed = 3;
   Localizer loc(map_, camera_, o, mount_);
   const Drive drive = MakeDrive({0.0, 0.0, 0.1}, 30, 0.03, 1.0 * kDeg, 1);
@@ -124,9 +120,9 @@ TEST_F(LocalizerTest, PlanarMccTracksFromAPose) {
   LocalizerOptions o;
   o.method = LocalizationMethod::kMcc;
   o.state = LocalizationState::kPlanar;
-  o.num_particles = 300;
-  o.kld.max_particles = 300;
-  o.init_spread_m = 0.05;
+  o.mcl.num_particles = 300;
+  o.mcl.kld.max_particles = 300;
+  o.init.spread_m = 0.05;
   o.seed = 4;
   Localizer loc(map_, camera_, o, mount_);
   const Drive drive = MakeDrive({0.2, -0.3, -0.4}, 30, 0.03, 1.5 * kDeg, 2);
@@ -150,10 +146,10 @@ TEST_F(LocalizerTest, SixDofMccTracksFromAPose) {
   LocalizerOptions o;
   o.method = LocalizationMethod::kMcc;
   o.state = LocalizationState::k6Dof;
-  o.num_particles = 300;
-  o.kld.max_particles = 300;
-  o.init_spread_m = 0.03;
-  o.init_spread_deg = 2.0;
+  o.mcl.num_particles = 300;
+  o.mcl.kld.max_particles = 300;
+  o.init.spread_m = 0.03;
+  o.init.spread_deg = 2.0;
   o.seed = 5;
   Localizer loc(map_, camera_, o);
   const Drive drive = MakeDrive({0.5, 0.5, 2.0}, 25, 0.03, -1.0 * kDeg, 3);
@@ -176,12 +172,12 @@ TEST_F(LocalizerTest, SixDofMccEstimateRefinementReducesError) {
     LocalizerOptions o;
     o.method = LocalizationMethod::kMcc;
     o.state = LocalizationState::k6Dof;
-    o.num_particles = 300;
-    o.kld.max_particles = 300;
-    o.init_spread_m = 0.03;
-    o.init_spread_deg = 2.0;
+    o.mcl.num_particles = 300;
+    o.mcl.kld.max_particles = 300;
+    o.init.spread_m = 0.03;
+    o.init.spread_deg = 2.0;
     o.seed = 5;
-    o.refine_estimate = with == 1;
+    o.mcc.refine_estimate = with == 1;
     Localizer loc(map_, camera_, o);
     loc.InitializeAtPose(WorldFromCamOfBase(drive.truth[0], mount_));
     std::vector<LocalizerStepStats> stats;
@@ -205,11 +201,11 @@ LocalizerOptions PlanarOverUnitArea(LocalizationMethod method, int particles,
   LocalizerOptions o;
   o.method = method;
   o.state = LocalizationState::kPlanar;
-  o.num_particles = particles;
-  o.kld.max_particles = particles;
-  o.kld.min_particles = min_particles;
-  o.area_min = {0.0, -0.5};
-  o.area_max = {1.0, 0.5};
+  o.mcl.num_particles = particles;
+  o.mcl.kld.max_particles = particles;
+  o.mcl.kld.min_particles = min_particles;
+  o.init.area_min = {0.0, -0.5};
+  o.init.area_max = {1.0, 0.5};
   return o;
 }
 
@@ -217,8 +213,8 @@ void GlobalInitCase(LocalizerTest* t, LocalizationMethod method,
                     std::vector<double>* e,
                     std::vector<LocalizerStepStats>* stats) {
   LocalizerOptions o = PlanarOverUnitArea(method, 3000, 200);
-  o.init = LocalizationInit::kGlobal;
-  o.mcc_top_k = 10;
+  o.init.kind = LocalizationInit::kGlobal;
+  o.mcc.top_k = 10;
   o.seed = 6;
   Localizer loc(t->map(), t->camera(), o, t->mount());
   loc.Initialize(std::nullopt);
@@ -273,11 +269,12 @@ TEST_F(LocalizerTest, MccRecoversFromAKidnappingByInjection) {
   auto run = [&](int min_injected) {
     LocalizerOptions o =
         PlanarOverUnitArea(LocalizationMethod::kMcc, 200, 50);
-    o.init_spread_m = 0.01;
-    o.init_spread_deg = 1.0;
-    o.injection_fraction = 0.0;
-    o.mcc_min_injected = min_injected;
-    o.relocalize_ncc_drop = 0.0;  // injection alone (see the test below)
+    o.init.spread_m = 0.01;
+    o.init.spread_deg = 1.0;
+    o.recovery.injection_fraction = 0.0;
+    o.recovery.mcc_min_injected = min_injected;
+    // Injection alone (see the test below).
+    o.recovery.relocalize_ncc_drop = 0.0;
     o.seed = 2;
     Localizer loc(map(), camera(), o, mount());
     loc.InitializeAtPose(WorldFromCamOfBase(
@@ -285,7 +282,8 @@ TEST_F(LocalizerTest, MccRecoversFromAKidnappingByInjection) {
     return Run(drive, &loc);
   };
   const std::vector<double> stuck = run(0);
-  const std::vector<double> recovered = run(LocalizerOptions().mcc_min_injected);
+  const std::vector<double> recovered =
+      run(LocalizerOptions().recovery.mcc_min_injected);
   std::printf("kidnapped: first %.3f m; last without injection %.3f m, with "
               "%.3f m\n",
               stuck.front(), stuck.back(), recovered.back());
@@ -318,11 +316,11 @@ TEST_F(LocalizerTest, RelocalizationRecoversFromAKidnappingWhileTracking) {
   }
   auto run = [&](double drop, std::vector<LocalizerStepStats>* stats) {
     LocalizerOptions o = PlanarOverUnitArea(LocalizationMethod::kMcc, 200, 50);
-    o.init_spread_m = 0.01;
-    o.init_spread_deg = 1.0;
-    o.injection_fraction = 0.0;
-    o.mcc_min_injected = 0;
-    o.relocalize_ncc_drop = drop;
+    o.init.spread_m = 0.01;
+    o.init.spread_deg = 1.0;
+    o.recovery.injection_fraction = 0.0;
+    o.recovery.mcc_min_injected = 0;
+    o.recovery.relocalize_ncc_drop = drop;
     o.seed = 3;
     Localizer loc(map(), camera(), o, mount());
     loc.InitializeAtPose(WorldFromCamOfBase(drive.truth[0], mount()));
@@ -331,7 +329,7 @@ TEST_F(LocalizerTest, RelocalizationRecoversFromAKidnappingWhileTracking) {
   std::vector<LocalizerStepStats> off_stats, on_stats;
   const std::vector<double> stuck = run(0.0, &off_stats);
   const std::vector<double> recovered =
-      run(LocalizerOptions().relocalize_ncc_drop, &on_stats);
+      run(LocalizerOptions().recovery.relocalize_ncc_drop, &on_stats);
   std::string fired;
   for (const LocalizerStepStats& s : on_stats)
     fired += s.relocalizing ? '1' : '0';
@@ -353,89 +351,12 @@ TEST_F(LocalizerTest, RelocalizationRecoversFromAKidnappingWhileTracking) {
   for (const LocalizerStepStats& s : off_stats) EXPECT_FALSE(s.relocalizing);
 }
 
-TEST_F(LocalizerTest, LocalizeSequenceReadsADataset) {
-  const std::filesystem::path dir =
-      std::filesystem::temp_directory_path() /
-      ("monomap_localizer_test_" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
-  Dataset ds;
-  ds.root = dir;
-  ds.camera = camera_;
-  ds.base_from_cam = mount_;
-  ds.has_groundtruth = true;
-  const Drive drive = MakeDrive({0.0, 0.3, -0.2}, 10, 0.03, 1.0 * kDeg, 5);
-  for (size_t i = 0; i < drive.truth.size(); ++i) {
-    DatasetFrame f;
-    f.timestamp = 0.1 * i;
-    f.image_path = dir / ("f" + std::to_string(i) + ".png");
-    const Rigid3d truth = WorldFromCamOfBase(drive.truth[i], mount_);
-    cv::imwrite(f.image_path.string(),
-                test_scene::LiveImage(renderer_, camera_, truth, 0.9, 5, 2.0,
-                                      i));
-    f.odometry_base = drive.odometry[i];
-    f.odometry_world_from_cam = WorldFromCamOfBase(drive.odometry[i], mount_);
-    f.groundtruth_world_from_cam = truth;
-    ds.frames.push_back(f);
-  }
-  LocalizerOptions o;
-  o.method = LocalizationMethod::kMcc;
-  o.num_particles = 200;
-  o.kld.max_particles = 200;
-  std::vector<TimedPose> trajectory;
-  std::vector<std::vector<Particle>> sets;
-
-  // Without a start pose the filter starts at the first odometry pose, not
-  // at the ground truth. This drive's odometry has its own origin, 0.36 m
-  // and 11 degrees from the true start: the particles are spread around
-  // the origin, so none of them is near the truth after the first update
-  // (MCL without injection: nothing else moves them).
-  Dataset first = ds;
-  first.frames.resize(1);
-  LocalizerOptions plain = o;
-  plain.method = LocalizationMethod::kMcl;
-  plain.injection_fraction = 0.0;
-  plain.relocalize_ncc_drop = 0.0;
-  LocalizeSequence(map_, first, plain, &trajectory, &sets);
-  ASSERT_EQ(sets.size(), 1u);
-  const Eigen::Vector3d odometry_start =
-      WorldFromCamOfBase(drive.odometry[0], mount_).translation;
-  const Eigen::Vector3d true_start =
-      WorldFromCamOfBase(drive.truth[0], mount_).translation;
-  double nearest_to_truth = 1e9, farthest_from_odometry = 0.0;
-  for (const Particle& p : sets[0]) {
-    const Eigen::Vector3d& t = p.world_from_cam.translation;
-    nearest_to_truth = std::min(nearest_to_truth, (t - true_start).norm());
-    farthest_from_odometry =
-        std::max(farthest_from_odometry, (t - odometry_start).norm());
-  }
-  EXPECT_LT(farthest_from_odometry, 0.3);
-  EXPECT_GT(nearest_to_truth, 0.1);
-
-  // Started at the true pose (init_pose), it tracks.
-  o.init_pose = WorldFromCamOfBase(drive.truth[0], mount_);
-  const LocalizationReport r = LocalizeSequence(map_, ds, o, &trajectory,
-                                                &sets);
-  std::filesystem::remove_all(dir);
-  EXPECT_EQ(r.frames, 10);
-  ASSERT_EQ(trajectory.size(), 10u);
-  EXPECT_EQ(sets.size(), 10u);
-  EXPECT_TRUE(r.has_errors);
-  EXPECT_LT(r.rmse_translation_m, 0.01);
-  EXPECT_LT(r.mean_rotation_error_deg, 0.5);
-  EXPECT_DOUBLE_EQ(r.fraction_within_10cm, 1.0);
-  EXPECT_NEAR(trajectory[3].timestamp, 0.3, 1e-12);
-
-  // The planar state without a camera mount is refused.
-  ds.base_from_cam.reset();
-  EXPECT_THROW(LocalizeSequence(map_, ds, o, &trajectory), InputError);
-}
-
 TEST_F(LocalizerTest, SixDofGlobalInitKeepsHeightAndTilt) {
   LocalizerOptions o;
   o.state = LocalizationState::k6Dof;
-  o.num_particles = 400;
-  o.area_min = {-0.5, -1.0};
-  o.area_max = {2.5, 1.0};
+  o.mcl.num_particles = 400;
+  o.init.area_min = {-0.5, -1.0};
+  o.init.area_max = {2.5, 1.0};
   Localizer loc(map_, camera_, o);
   // No map trajectory and no reference: height and tilt are unknown.
   EXPECT_THROW(loc.InitializeGlobal(), StageError);
@@ -457,16 +378,30 @@ TEST_F(LocalizerTest, SixDofGlobalInitKeepsHeightAndTilt) {
 TEST(LocalizerOptions, CheckAndParse) {
   LocalizerOptions o;
   EXPECT_NO_THROW(o.Check());
-  o.injection_fraction = 1.5;
+  o.recovery.injection_fraction = 1.5;
   EXPECT_THROW(o.Check(), OptionsError);
   o = {};
-  o.num_particles = 0;
+  o.mcl.num_particles = 0;
   EXPECT_THROW(o.Check(), OptionsError);
   o = {};
-  o.relocalize_alpha_slow = o.relocalize_alpha_fast;  // slow must be slower
+  // The slow average must be slower.
+  o.recovery.relocalize_alpha_slow = o.recovery.relocalize_alpha_fast;
   EXPECT_THROW(o.Check(), OptionsError);
   o = {};
-  o.relocalize_ncc_drop = -1.0;
+  o.recovery.relocalize_ncc_drop = -1.0;
+  EXPECT_THROW(o.Check(), OptionsError);
+  // Each stage's options are checked.
+  o = {};
+  o.mcc.top_k = -1;
+  EXPECT_THROW(o.Check(), OptionsError);
+  o = {};
+  o.mcc.refinement.width = 8;
+  EXPECT_THROW(o.Check(), OptionsError);
+  o = {};
+  o.init.spread_deg = -1.0;
+  EXPECT_THROW(o.Check(), OptionsError);
+  o = {};
+  o.mcl.cluster_radius_m = 0.0;
   EXPECT_THROW(o.Check(), OptionsError);
   EXPECT_EQ(ParseLocalizationMethod("mcc"), LocalizationMethod::kMcc);
   EXPECT_EQ(ParseLocalizationState("6dof"), LocalizationState::k6Dof);

@@ -77,13 +77,30 @@ Rigid3d RigidFromCv(const cv::Mat& rvec, const cv::Mat& tvec) {
 
 }  // namespace
 
-bool MonteCarloCorrector::Round(const cv::Mat& live_raw, const Rigid3d& start,
-                                Rigid3d* out, MccResult* stats) const {
-  const MccOptions& o = options_;
+namespace {
+
+// A render of the map from the start pose, the corners to track in it and
+// the KLT pyramids of the render and of the live image.
+struct RenderedView {
   cv::Mat render, depth;
-  renderer_.Render(render_camera_, start, &render, &depth);
+  std::vector<cv::Point2f> corners;
+  std::vector<cv::Mat> render_pyramid, live_pyramid;
+};
+
+// 3D-2D matches: render corners back-projected with the render's depth,
+// and where KLT found them in the live image.
+struct Matches {
+  std::vector<cv::Point3d> object;
+  std::vector<cv::Point2d> image;
+};
+
+RenderedView RenderView(const Renderer& renderer, const Camera& camera,
+                        const MccOptions& o, const PyrLkOptions& lk,
+                        const cv::Mat& live_raw, const Rigid3d& start) {
+  RenderedView v;
+  renderer.Render(camera, start, &v.render, &v.depth);
   // Corners only well inside the map's silhouette.
-  cv::Mat mask = depth > 0.0f;
+  cv::Mat mask = v.depth > 0.0f;
   if (o.border_px > 0) {
     cv::erode(mask, mask,
               cv::getStructuringElement(
@@ -93,14 +110,9 @@ bool MonteCarloCorrector::Round(const cv::Mat& live_raw, const Rigid3d& start,
   // Corner detection on the render runs beside the preparation of the two
   // images for KLT (the full-size refinement is one correction at a time,
   // and these steps are most of its time).
-  std::vector<cv::Point2f> corners;
-  std::vector<cv::Mat> render_pyramid, live_pyramid;
-  PyrLkOptions lk;
-  lk.window = o.klt_window;
-  lk.levels = o.klt_levels;
   tbb::parallel_invoke(
       [&] {
-        cv::goodFeaturesToTrack(render, corners, o.max_corners,
+        cv::goodFeaturesToTrack(v.render, v.corners, o.max_corners,
                                 o.corner_quality, o.min_corner_distance_px,
                                 mask);
       },
@@ -109,7 +121,7 @@ bool MonteCarloCorrector::Round(const cv::Mat& live_raw, const Rigid3d& start,
         // render's gain and offset (mean and spread over the map pixels),
         // else exposure changes bias the tracks by tenths of a pixel.
         cv::Scalar mr, sr, ml, sl;
-        cv::meanStdDev(render, mr, sr, mask);
+        cv::meanStdDev(v.render, mr, sr, mask);
         cv::meanStdDev(live_raw, ml, sl, mask);
         cv::Mat live;
         if (sl[0] > 1.0 && sr[0] > 1.0) {
@@ -118,43 +130,65 @@ bool MonteCarloCorrector::Round(const cv::Mat& live_raw, const Rigid3d& start,
         } else {
           live = live_raw;
         }
-        BuildLkPyramid(render, lk, &render_pyramid);
-        BuildLkPyramid(live, lk, &live_pyramid);
+        BuildLkPyramid(v.render, lk, &v.render_pyramid);
+        BuildLkPyramid(live, lk, &v.live_pyramid);
       });
-  stats->corners = static_cast<int>(corners.size());
-  stats->tracked = stats->inliers = 0;
-  if (static_cast<int>(corners.size()) < o.min_inliers) return false;
+  return v;
+}
 
+// Tracks the corners into the live image and back; those that return
+// within max_forward_backward_px and have depth become matches.
+Matches TrackCorners(const RenderedView& v, const Camera& c,
+                     const MccOptions& o, PyrLkOptions lk,
+                     const Rigid3d& start) {
+  const std::vector<cv::Point2f>& corners = v.corners;
   std::vector<cv::Point2f> fwd, back;
   std::vector<uchar> st_f, st_b;
   std::vector<float> err;
-  PyramidalLk(render_pyramid, live_pyramid, corners, &fwd, &st_f, &err, lk);
+  PyramidalLk(v.render_pyramid, v.live_pyramid, corners, &fwd, &st_f, &err,
+              lk);
   back = corners;  // backward starts at the original corner positions
   lk.use_initial_guess = true;
-  PyramidalLk(live_pyramid, render_pyramid, fwd, &back, &st_b, &err, lk);
-
-  const Camera& c = render_camera_;
-  std::vector<cv::Point3d> object;
-  std::vector<cv::Point2d> image;
+  PyramidalLk(v.live_pyramid, v.render_pyramid, fwd, &back, &st_b, &err, lk);
+  Matches m;
   for (size_t i = 0; i < corners.size(); ++i) {
     if (!st_f[i] || !st_b[i]) continue;
     const cv::Point2f d = back[i] - corners[i];
     if (d.dot(d) > o.max_forward_backward_px * o.max_forward_backward_px)
       continue;
-    const int u = cvRound(corners[i].x), v = cvRound(corners[i].y);
-    if (u < 0 || v < 0 || u >= depth.cols || v >= depth.rows) continue;
-    const float z = depth.at<float>(v, u);
+    const int u = cvRound(corners[i].x), w = cvRound(corners[i].y);
+    if (u < 0 || w < 0 || u >= v.depth.cols || w >= v.depth.rows) continue;
+    const float z = v.depth.at<float>(w, u);
     if (!(z > 0.0f)) continue;
     // Back-project the corner (exact at the pixel centre it was found on).
     const Eigen::Vector3d x_cam((corners[i].x - c.cx) / c.fx * z,
                                 (corners[i].y - c.cy) / c.fy * z, z);
     const Eigen::Vector3d x = start * x_cam;
-    object.emplace_back(x.x(), x.y(), x.z());
-    image.emplace_back(fwd[i].x, fwd[i].y);
+    m.object.emplace_back(x.x(), x.y(), x.z());
+    m.image.emplace_back(fwd[i].x, fwd[i].y);
   }
-  stats->tracked = static_cast<int>(object.size());
-  if (stats->tracked < o.min_inliers) return false;
+  return m;
+}
 
+// RMS reprojection error (px) of the points at pose (r, t).
+double RmsReprojection(const std::vector<cv::Point3d>& object,
+                       const std::vector<cv::Point2d>& image,
+                       const cv::Mat& k, const cv::Mat& r, const cv::Mat& t) {
+  std::vector<cv::Point2d> proj;
+  cv::projectPoints(object, r, t, k, cv::noArray(), proj);
+  double sum_sq = 0.0;
+  for (size_t i = 0; i < proj.size(); ++i) {
+    const cv::Point2d d = proj[i] - image[i];
+    sum_sq += d.dot(d);
+  }
+  return std::sqrt(sum_sq / proj.size());
+}
+
+// The pose of the matches by PnP: RANSAC, then Levenberg-Marquardt on the
+// inliers; false if too few inliers or the fit is worse than the RANSAC
+// threshold. Sets stats' inliers and rms.
+bool SolvePose(const Matches& m, const Camera& c, const MccOptions& o,
+               const Rigid3d& start, Rigid3d* out, MccResult* stats) {
   const cv::Mat k = (cv::Mat_<double>(3, 3) << c.fx, 0, c.cx, 0, c.fy, c.cy,
                      0, 0, 1);
   cv::Mat tvec;
@@ -163,29 +197,18 @@ bool MonteCarloCorrector::Round(const cv::Mat& live_raw, const Rigid3d& start,
   cv::Mat rvec_start = rvec.clone(), tvec_start = tvec.clone();
   std::vector<int> inliers;
   const bool ok = cv::solvePnPRansac(
-      object, image, k, cv::noArray(), rvec, tvec, /*useExtrinsicGuess=*/true,
-      o.ransac_iterations, static_cast<float>(o.ransac_threshold_px), 0.999,
-      inliers, cv::SOLVEPNP_ITERATIVE);
-  if (!ok || static_cast<int>(inliers.size()) < o.min_inliers) {
-    stats->inliers = static_cast<int>(inliers.size());
-    return false;
-  }
+      m.object, m.image, k, cv::noArray(), rvec, tvec,
+      /*useExtrinsicGuess=*/true, o.ransac_iterations,
+      static_cast<float>(o.ransac_threshold_px), 0.999, inliers,
+      cv::SOLVEPNP_ITERATIVE);
+  stats->inliers = static_cast<int>(inliers.size());
+  if (!ok || static_cast<int>(inliers.size()) < o.min_inliers) return false;
   std::vector<cv::Point3d> in_obj;
   std::vector<cv::Point2d> in_img;
   for (int i : inliers) {
-    in_obj.push_back(object[i]);
-    in_img.push_back(image[i]);
+    in_obj.push_back(m.object[i]);
+    in_img.push_back(m.image[i]);
   }
-  auto rms = [&](const cv::Mat& r, const cv::Mat& t) {
-    std::vector<cv::Point2d> proj;
-    cv::projectPoints(in_obj, r, t, k, cv::noArray(), proj);
-    double sum_sq = 0.0;
-    for (size_t i = 0; i < proj.size(); ++i) {
-      const cv::Point2d d = proj[i] - in_img[i];
-      sum_sq += d.dot(d);
-    }
-    return std::sqrt(sum_sq / proj.size());
-  };
   // The pose solvePnPRansac returns for its inliers occasionally runs off
   // (tens of px of error, metres away, on simulated hallways), so the
   // inliers are fitted by Levenberg-Marquardt from both that pose and the
@@ -193,18 +216,37 @@ bool MonteCarloCorrector::Round(const cv::Mat& live_raw, const Rigid3d& start,
   cv::solvePnPRefineLM(in_obj, in_img, k, cv::noArray(), rvec, tvec);
   cv::solvePnPRefineLM(in_obj, in_img, k, cv::noArray(), rvec_start,
                        tvec_start);
-  double best_rms = rms(rvec, tvec);
-  const double start_rms = rms(rvec_start, tvec_start);
+  double best_rms = RmsReprojection(in_obj, in_img, k, rvec, tvec);
+  const double start_rms =
+      RmsReprojection(in_obj, in_img, k, rvec_start, tvec_start);
   if (start_rms < best_rms) {
     best_rms = start_rms;
     rvec = rvec_start;
     tvec = tvec_start;
   }
-  stats->inliers = static_cast<int>(inliers.size());
   stats->rms_reprojection_px = best_rms;
   if (!(best_rms <= o.ransac_threshold_px)) return false;
   *out = RigidFromCv(rvec, tvec).Inverse();
   return true;
+}
+
+}  // namespace
+
+bool MonteCarloCorrector::Round(const cv::Mat& live_raw, const Rigid3d& start,
+                                Rigid3d* out, MccResult* stats) const {
+  PyrLkOptions lk;
+  lk.window = options_.klt_window;
+  lk.levels = options_.klt_levels;
+  const RenderedView view =
+      RenderView(renderer_, render_camera_, options_, lk, live_raw, start);
+  stats->corners = static_cast<int>(view.corners.size());
+  stats->tracked = stats->inliers = 0;
+  if (stats->corners < options_.min_inliers) return false;
+  const Matches matches =
+      TrackCorners(view, render_camera_, options_, lk, start);
+  stats->tracked = static_cast<int>(matches.object.size());
+  if (stats->tracked < options_.min_inliers) return false;
+  return SolvePose(matches, render_camera_, options_, start, out, stats);
 }
 
 MccResult MonteCarloCorrector::Correct(const cv::Mat& live,

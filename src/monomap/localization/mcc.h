@@ -28,11 +28,7 @@ struct MccOptions {
   // KLT window side and pyramid levels above the base. Few levels and a
   // small window: at 160x120 the top of a 3-level pyramid is 20x15 px, its
   // windows span the map's silhouette against the background, and most
-  // tracks run off (simulated room: 33 of 71 corners tracked at the true
-  // pose with 15 px / 3 levels, 46 of 70 with 11 px / 1 level; with the
-  // other MCC settings of the same change, a correction from 20 cm behind
-  // the truth is accepted in 71 % of the frames instead of 0 %;
-  // bench/mcc_basin).
+  // tracks run off (docs/benchmarks.md, MCC basin; bench/mcc_basin).
   int klt_window = 11;
   int klt_levels = 1;
   // Forward-backward KLT check: largest round-trip error (px).
@@ -43,18 +39,15 @@ struct MccOptions {
   // A correction needs this many inliers...
   int min_inliers = 15;
   // ... and may move the pose at most this far (m, degrees): the basin
-  // reaches 20-30 cm; the inlier fit (rms <= ransac_threshold_px) guards
-  // against wrong matches. 20 deg rather than 10: kidnapped, MCC stalled
-  // where particles sat near the truth but 13-14 deg off in heading (20
-  // seeds: recovered 15 -> 18 of 20 in the hallway, 8 -> 11 in the room;
-  // global starts unchanged; docs/benchmarks.md "Kidnapped robot").
+  // reaches 20-30 cm, and the inlier fit (rms <= ransac_threshold_px)
+  // guards against wrong matches. 20 deg rather than 10 lets MCC recover
+  // particles near the truth but well off in heading after a kidnapping
+  // (docs/benchmarks.md, "Kidnapped robot").
   double max_translation_m = 0.5;
   double max_rotation_deg = 20.0;
   // Added to the renderer's mip bias for the renders tracked here: half a
   // level blurrier tames aliasing along oblique views, which KLT minds more
-  // than the weights do (synthetic 6-DoF tracking 0.61 mm, 0.43 refined,
-  // instead of 0.88 and 0.80; simulated room seed 5, global start:
-  // localized instead of lost).
+  // than the weights do (docs/benchmarks.md).
   double extra_mip_bias = 0.5;
   // Render-track-solve rounds; the second one starts from an almost
   // aligned render and removes most of the first round's bias.

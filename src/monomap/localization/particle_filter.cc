@@ -29,14 +29,6 @@ double WrapAngle(double a) {
   return a;
 }
 
-Pose2d BaseOfWorldFromCam(const Rigid3d& world_from_cam,
-                          const Rigid3d& base_from_cam) {
-  const Rigid3d world_from_base = world_from_cam * base_from_cam.Inverse();
-  const Eigen::Matrix3d r = world_from_base.RotationMatrix();
-  return {world_from_base.translation.x(), world_from_base.translation.y(),
-          std::atan2(r(1, 0), r(0, 0))};
-}
-
 void OdometryNoise2d::Check() const {
   CheckOption(alpha1 >= 0 && alpha2 >= 0 && alpha3 >= 0 && alpha4 >= 0,
               "odometry_noise2d.alpha", "must be >= 0");
@@ -184,26 +176,8 @@ void KldOptions::Check() const {
 
 namespace {
 
-// Hash of a histogram bin of a pose.
-uint64_t BinKey(const Particle& p, const KldOptions& o, bool planar) {
-  auto q = [](double v, double size) {
-    return static_cast<int64_t>(std::floor(v / size));
-  };
-  int64_t c[6];
-  if (planar) {
-    c[0] = q(p.base.x, o.bin_xy_m);
-    c[1] = q(p.base.y, o.bin_xy_m);
-    c[2] = q(WrapAngle(p.base.yaw) + M_PI, o.bin_angle_rad);
-    c[3] = c[4] = c[5] = 0;
-  } else {
-    const Eigen::Vector3d& t = p.world_from_cam.translation;
-    const Eigen::Vector3d w =
-        RotationVectorFromQuaternion(p.world_from_cam.rotation);
-    c[0] = q(t.x(), o.bin_xy_m);
-    c[1] = q(t.y(), o.bin_xy_m);
-    c[2] = q(t.z(), o.bin_z_m);
-    for (int i = 0; i < 3; ++i) c[3 + i] = q(w[i], o.bin_angle_rad);
-  }
+// Hash of a histogram bin.
+uint64_t BinHash(const KldBin& c) {
   uint64_t h = 1469598103934665603ull;
   for (int64_t v : c) {
     h ^= static_cast<uint64_t>(v) + 0x9e3779b97f4a7c15ull + (h << 6) + (h >> 2);
@@ -215,7 +189,8 @@ uint64_t BinKey(const Particle& p, const KldOptions& o, bool planar) {
 
 std::vector<int> KldResample(const std::vector<Particle>& particles,
                              const std::vector<double>& weights,
-                             const KldOptions& o, bool planar, Rng* rng,
+                             const KldOptions& o,
+                             const KldBinFunction& bin_of, Rng* rng,
                              int* bins) {
   std::vector<int> all = LowVarianceResample(weights, o.max_particles, rng);
   // A random prefix of a systematic sample is a sample without replacement
@@ -228,7 +203,7 @@ std::vector<int> KldResample(const std::vector<Particle>& particles,
   double needed = o.min_particles;
   for (int idx : all) {
     out.push_back(idx);
-    if (occupied.insert(BinKey(particles[idx], o, planar)).second) {
+    if (occupied.insert(BinHash(bin_of(particles[idx]))).second) {
       needed = std::max<double>(
           o.min_particles,
           KldBound(static_cast<int>(occupied.size()), o.epsilon, o.delta));

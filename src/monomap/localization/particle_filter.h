@@ -5,14 +5,16 @@
 // here knows about images; measurement_model.h weighs particles.
 #pragma once
 
+#include <array>
 #include <cstdint>
+#include <functional>
 #include <random>
 #include <vector>
 
 #include <Eigen/Core>
 
 #include "monomap/geometry/rigid3.h"
-#include "monomap/io/dataset.h"
+#include "monomap/geometry/pose2d.h"
 
 namespace monomap {
 
@@ -20,17 +22,14 @@ using Rng = std::mt19937_64;
 
 // One hypothesis. `world_from_cam` is always valid; with the planar state
 // `base` is the state and world_from_cam = WorldFromCamOfBase(base, mount).
+// Particles are made and moved by a StateModel (state_model.h), which keeps
+// the two in step.
 struct Particle {
   Rigid3d world_from_cam;
   Pose2d base;
   // Unnormalized log weight (log likelihoods add up between resamplings).
   double log_weight = 0.0;
 };
-
-// Robot base pose of a camera pose (inverse of WorldFromCamOfBase): the
-// base frame's x, y and yaw; its height, roll and pitch are dropped.
-Pose2d BaseOfWorldFromCam(const Rigid3d& world_from_cam,
-                          const Rigid3d& base_from_cam);
 
 // Wraps an angle to (-pi, pi].
 double WrapAngle(double a);
@@ -109,8 +108,8 @@ double NormalQuantile(double p);
 double KldBound(int k, double epsilon, double delta);
 
 struct KldOptions {
-  // Bin sizes of the (x, y, z, roll, pitch, yaw) histogram (z, roll and
-  // pitch ignored with the planar state).
+  // Bin sizes of the histogram (x and y, z, angles); the state model
+  // decides which coordinates it has (StateModel::Bin).
   double bin_xy_m = 0.05;
   double bin_z_m = 0.05;
   double bin_angle_rad = 0.0873;  // 5 degrees
@@ -125,13 +124,20 @@ struct KldOptions {
   void Check() const;
 };
 
+// A cell of the (x, y, z, roll, pitch, yaw) histogram of KLD-sampling
+// (coordinates a state does not have are 0).
+using KldBin = std::array<int64_t, 6>;
+using KldBinFunction = std::function<KldBin(const Particle&)>;
+
 // KLD resampling: draws a low-variance sample of max_particles, shuffles it
 // and keeps the shortest prefix whose count reaches
-// max(min_particles, KldBound(occupied bins)). Returns indices into
-// `weights`; `bins` (optional) receives the number of occupied bins.
+// max(min_particles, KldBound(occupied bins)), bins given by `bin_of`.
+// Returns indices into `weights`; `bins` (optional) receives the number of
+// occupied bins.
 std::vector<int> KldResample(const std::vector<Particle>& particles,
                              const std::vector<double>& weights,
-                             const KldOptions& options, bool planar, Rng* rng,
+                             const KldOptions& options,
+                             const KldBinFunction& bin_of, Rng* rng,
                              int* bins = nullptr);
 
 // Merges particles closer than max_translation_m and max_rotation_rad to

@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include "monomap/localization/state_model.h"
+
 namespace monomap {
 namespace {
 
@@ -192,7 +194,10 @@ TEST(Kld, ResampleCountGrowsWithSpread) {
     }
     const std::vector<double> w(ps.size(), 1.0);
     int bins = 0;
-    const std::vector<int> idx = KldResample(ps, w, o, true, &rng, &bins);
+    const PlanarStateModel planar{Rigid3d(), OdometryNoise2d()};
+    const std::vector<int> idx = KldResample(
+        ps, w, o, [&](const Particle& p) { return planar.Bin(p, o); }, &rng,
+        &bins);
     // The count is the bound of the bins seen (or the minimum).
     EXPECT_GE(static_cast<double>(idx.size()),
               std::min<double>(o.max_particles,
@@ -267,16 +272,6 @@ TEST(Particles, WeightedMeanPoseIgnoresQuaternionSign) {
   const Rigid3d m2 = WeightedMeanPose(poses, {3.0, 1.0});
   EXPECT_NEAR(m2.translation.x(), 1.5, 1e-12);
   EXPECT_NEAR(RotationVectorFromQuaternion(m2.rotation).z(), 0.05, 2e-3);
-}
-
-TEST(Particles, BaseRoundTrip) {
-  const Rigid3d mount(QuaternionFromRotationVector({-1.9, 0.1, -0.05}),
-                      {0.1, 0.02, 0.5});
-  const Pose2d b{1.5, -0.7, 2.9};
-  const Pose2d back = BaseOfWorldFromCam(WorldFromCamOfBase(b, mount), mount);
-  EXPECT_NEAR(back.x, b.x, 1e-12);
-  EXPECT_NEAR(back.y, b.y, 1e-12);
-  EXPECT_NEAR(WrapAngle(back.yaw - b.yaw), 0.0, 1e-12);
 }
 
 }  // namespace

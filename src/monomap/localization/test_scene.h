@@ -13,7 +13,7 @@
 
 #include "monomap/camera/camera.h"
 #include "monomap/geometry/plane.h"
-#include "monomap/io/dataset.h"
+#include "monomap/geometry/pose2d.h"
 #include "monomap/map/map.h"
 #include "monomap/rendering/renderer.h"
 

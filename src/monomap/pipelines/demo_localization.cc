@@ -94,18 +94,20 @@ DemoLocalization RunDemoLocalization(const Map& map,
   for (DatasetFrame& f : live.frames) f.groundtruth_world_from_cam.reset();
   for (const LocalizationMethod method :
        {LocalizationMethod::kMcl, LocalizationMethod::kMcc}) {
-    LocalizerOptions lo;
+    LocalizationPipelineOptions po;
+    LocalizerOptions& lo = po.localizer;
     lo.method = method;
     lo.state = LocalizationState::kPlanar;
-    lo.init = LocalizationInit::kGlobal;
-    lo.num_particles = options.particles;
-    lo.kld.max_particles = options.particles;
-    lo.kld.min_particles = std::min(lo.kld.min_particles, options.particles);
+    lo.init.kind = LocalizationInit::kGlobal;
+    lo.mcl.num_particles = options.particles;
+    lo.mcl.kld.max_particles = options.particles;
+    lo.mcl.kld.min_particles =
+        std::min(lo.mcl.kld.min_particles, options.particles);
     lo.seed = mapping_sim.seed;
     DemoLocalizationRun run;
     run.name = method == LocalizationMethod::kMcc ? "MCC" : "MCL";
     std::vector<std::vector<Particle>> sets;
-    run.report = LocalizeSequence(map, live, lo, &run.trajectory, &sets);
+    run.report = LocalizeSequence(map, live, po, &run.trajectory, &sets);
     run.accuracy =
         EvaluateLocalization(run.trajectory, out.groundtruth, options.accuracy);
     std::mt19937_64 rng(mapping_sim.seed);

@@ -18,6 +18,7 @@
 #include "monomap/geometry/rigid3.h"
 #include "monomap/localization/localizer.h"
 #include "monomap/map/map.h"
+#include "monomap/pipelines/localization_pipeline.h"
 #include "monomap/sim/simulate.h"
 
 namespace monomap {

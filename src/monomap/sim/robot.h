@@ -10,7 +10,7 @@
 #include <Eigen/Core>
 
 #include "monomap/geometry/rigid3.h"
-#include "monomap/io/dataset.h"
+#include "monomap/geometry/pose2d.h"
 #include "monomap/sim/world.h"
 
 namespace monomap {

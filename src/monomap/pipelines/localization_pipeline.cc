@@ -1,0 +1,150 @@
+#include "monomap/pipelines/localization_pipeline.h"
+
+#include <cmath>
+
+#include "monomap/util/error.h"
+#include "monomap/util/progress.h"
+
+namespace monomap {
+
+void LocalizationPipelineOptions::Check() const {
+  localizer.Check();
+  CheckOption(within_m > 0, "within_m", "must be > 0");
+}
+
+nlohmann::json LocalizationReport::ToJson() const {
+  nlohmann::json j;
+  j["frames"] = frames;
+  j["seconds"] = seconds;
+  j["mean_step_seconds"] = mean_step_seconds;
+  j["mean_particles"] = mean_particles;
+  j["mcc_accepted"] = mcc_accepted;
+  if (has_errors) {
+    j["rmse_translation_m"] = rmse_translation_m;
+    j["mean_rotation_error_deg"] = mean_rotation_error_deg;
+    j["final_translation_error_m"] = final_translation_error_m;
+    j["final_rotation_error_deg"] = final_rotation_error_deg;
+    j["fraction_within_10cm"] = fraction_within_10cm;
+  }
+  nlohmann::json steps_json = nlohmann::json::array();
+  for (const LocalizerStepStats& s : steps) {
+    steps_json.push_back({{"particles", s.particles},
+                          {"ess", s.ess},
+                          {"best_ncc", s.best_ncc},
+                          {"mcc_accepted", s.mcc_accepted},
+                          {"merged", s.merged},
+                          {"injected", s.injected},
+                          {"relocalizing", s.relocalizing},
+                          {"particles_weighed", s.particles_weighed},
+                          {"refined", s.refined},
+                          {"weigh_seconds", s.weigh_seconds},
+                          {"mcc_seconds", s.mcc_seconds},
+                          {"seconds", s.seconds}});
+  }
+  j["steps"] = steps_json;
+  return j;
+}
+
+namespace {
+
+// The planar state needs 2D odometry for every frame and the camera mount
+// (checked in this order: the mount is read only along with the odometry).
+void CheckDatasetForState(const Dataset& dataset, LocalizationState state) {
+  if (state != LocalizationState::kPlanar) return;
+  for (const DatasetFrame& f : dataset.frames) {
+    if (!f.odometry_base) {
+      throw InputError(dataset.root.string(), "odometry2d.txt",
+                       "the planar state needs 2D odometry for every frame "
+                       "(or use --state 6dof)");
+    }
+  }
+  if (!dataset.base_from_cam) {
+    throw InputError(dataset.root.string(), "camera_mount.yaml",
+                     "the planar state needs the camera mount");
+  }
+}
+
+OdometryIncrement IncrementBetween(const DatasetFrame& prev,
+                                   const DatasetFrame& cur, bool planar) {
+  OdometryIncrement odometry;
+  odometry.cam_prev_from_cam_cur =
+      prev.odometry_world_from_cam.Inverse() * cur.odometry_world_from_cam;
+  if (planar) {
+    odometry.base_prev = *prev.odometry_base;
+    odometry.base_cur = *cur.odometry_base;
+  }
+  return odometry;
+}
+
+// The errors of the estimates against the frames' ground truth, computed
+// by eval; nothing if no frame has ground truth.
+void AddErrors(const Dataset& dataset, const std::vector<TimedPose>& estimate,
+               double within_m, LocalizationReport* report) {
+  std::vector<TimedPose> groundtruth;
+  for (const DatasetFrame& f : dataset.frames) {
+    if (f.groundtruth_world_from_cam) {
+      groundtruth.push_back({f.timestamp, *f.groundtruth_world_from_cam});
+    }
+  }
+  if (groundtruth.empty()) return;
+  const LocalizationAccuracy a = EvaluateLocalization(estimate, groundtruth);
+  double sum_sq = 0.0;
+  int within = 0;
+  for (const double e : a.translation_error_m) {
+    sum_sq += e * e;
+    within += e < within_m ? 1 : 0;
+  }
+  report->has_errors = true;
+  report->rmse_translation_m = std::sqrt(sum_sq / a.matched);
+  report->mean_rotation_error_deg = a.mean_rotation_error_all_deg;
+  report->final_translation_error_m = a.final_translation_error_m;
+  report->final_rotation_error_deg = a.final_rotation_error_deg;
+  report->fraction_within_10cm = static_cast<double>(within) / a.matched;
+}
+
+}  // namespace
+
+LocalizationReport LocalizeSequence(
+    const Map& map, const Dataset& dataset,
+    const LocalizationPipelineOptions& options,
+    std::vector<TimedPose>* trajectory,
+    std::vector<std::vector<Particle>>* particle_sets) {
+  options.Check();
+  if (dataset.frames.empty()) throw InputError("localization: no frames");
+  const LocalizerOptions& lo = options.localizer;
+  const bool planar = lo.state == LocalizationState::kPlanar;
+  CheckDatasetForState(dataset, lo.state);
+  const Timer timer;
+  Localizer localizer(map, dataset.camera, lo, dataset.base_from_cam);
+  localizer.Initialize(dataset.frames.front().odometry_world_from_cam);
+
+  LocalizationReport report;
+  std::vector<TimedPose> estimate;
+  if (particle_sets) particle_sets->clear();
+  ProgressBar progress("localize", dataset.frames.size(),
+                       options.show_progress);
+  for (size_t i = 0; i < dataset.frames.size(); ++i) {
+    const DatasetFrame& f = dataset.frames[i];
+    const OdometryIncrement odometry =
+        i > 0 ? IncrementBetween(dataset.frames[i - 1], f, planar)
+              : OdometryIncrement();
+    const LocalizerEstimate e = localizer.Step(dataset.LoadImage(i), odometry);
+    estimate.push_back({f.timestamp, e.world_from_cam});
+    if (particle_sets) particle_sets->push_back(localizer.particles());
+    report.steps.push_back(e.stats);
+    report.mean_step_seconds += e.stats.seconds;
+    report.mean_particles += e.stats.particles;
+    report.mcc_accepted += e.stats.mcc_accepted;
+    progress.Advance();
+  }
+  progress.Finish();
+  report.frames = static_cast<int>(dataset.frames.size());
+  report.mean_step_seconds /= report.frames;
+  report.mean_particles /= report.frames;
+  AddErrors(dataset, estimate, options.within_m, &report);
+  if (trajectory) *trajectory = std::move(estimate);
+  report.seconds = timer.ElapsedSeconds();
+  return report;
+}
+
+}  // namespace monomap
