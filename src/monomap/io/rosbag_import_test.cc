@@ -1,5 +1,7 @@
 #include "monomap/io/rosbag_import.h"
 
+#include <unistd.h>
+
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -15,7 +17,16 @@ namespace {
 namespace fs = std::filesystem;
 using namespace rosbag_test;
 
-const fs::path kDir = fs::temp_directory_path() / "monomap_rosbag_import_test";
+// Per process (other checkouts may run the same tests at the same time),
+// removed when the test program ends.
+const fs::path kDir = fs::temp_directory_path() /
+                      ("monomap_rosbag_import_test_" + std::to_string(getpid()));
+struct RemoveAtExit {
+  ~RemoveAtExit() {
+    std::error_code ec;
+    fs::remove_all(kDir, ec);
+  }
+} remove_at_exit;
 
 Camera TestCamera() {
   Camera c;
@@ -229,7 +240,7 @@ TEST(RosbagImport, CompressedPngAndJpeg) {
 std::string ImportError(const fs::path& bag, const RosbagImportOptions& o) {
   const fs::path out = kDir / "kept";
   fs::remove_all(out);
-  fs::create_directories(out);
+  MarkOutputDirectory(out, "dataset");  // a previous import
   WriteFileAtomic(out / "marker", "old");
   std::string message;
   try {

@@ -1,5 +1,7 @@
 #include "monomap/io/standard_import.h"
 
+#include <unistd.h>
+
 #include <gtest/gtest.h>
 
 #include <opencv2/imgcodecs.hpp>
@@ -15,8 +17,16 @@ namespace monomap {
 namespace {
 namespace fs = std::filesystem;
 
-const fs::path kDir =
-    fs::temp_directory_path() / "monomap_standard_import_test";
+// Per process (other checkouts may run the same tests at the same time),
+// removed when the test program ends.
+const fs::path kDir = fs::temp_directory_path() /
+                      ("monomap_standard_import_test_" + std::to_string(getpid()));
+struct RemoveAtExit {
+  ~RemoveAtExit() {
+    std::error_code ec;
+    fs::remove_all(kDir, ec);
+  }
+} remove_at_exit;
 
 // A hand-held camera path: moving forward and sideways, turning slowly.
 Rigid3d TruePose(double t) {
