@@ -4,7 +4,8 @@
 # configurations, over seeds; median errors against groundtruth.txt and
 # against board poses under a lens refitted on frames 151-300 (held out
 # from the mapping frames). Figures and their discussion:
-# docs/benchmarks.md ("Desk: odometry span priors" and the sections before).
+# docs/benchmarks.md ("Desk localization" and "Desk orientation: the
+# ground truth's own error").
 #
 #   scripts/desk_localization.sh [DATASET] [OUT_DIR] [SEEDS]
 #   defaults: ../shared/data/desk_vamr_a /tmp/desk_localization 5

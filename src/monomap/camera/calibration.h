@@ -5,9 +5,9 @@
 // Why in a mapping toolkit: every stage trusts the calibration, and an
 // error at the image's rim does not show in a bundle adjustment's
 // residuals, it bends the poses instead. desk_vamr_a's shipped calibration
-// fits the sequence's own board corners at 0.18 px RMS; refitted on 60 of
-// its frames, 0.048 px, and the localization's orientation error against
-// the board's poses drops from 0.33 to 0.11 deg (docs/benchmarks.md).
+// fits the sequence's own board corners at 0.18 px RMS and a refit does
+// better; the effect on localization is in docs/benchmarks.md ("Desk
+// localization").
 #pragma once
 
 #include <functional>

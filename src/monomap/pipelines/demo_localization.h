@@ -36,8 +36,8 @@ struct DemoLocalizationOptions {
   uint64_t run_seed_offset = 1000;
   // Particle budget of both methods (initial count and KLD maximum). A
   // corridor seen at 80x60 has look-alike stretches metres apart; 1000
-  // particles over the whole hallway often lock onto one of them (see the
-  // 20-seed figures in docs/benchmarks.md), 3000 cover it densely enough.
+  // particles over the whole hallway often lock onto one of them, 3000
+  // cover it densely enough (docs/design-notes.md, "particle budget").
   int particles = 3000;
   // Particles kept per step for the report (a random subset keeps the
   // page small).
