@@ -23,6 +23,7 @@
 #include "monomap/io/map_format.h"
 #include "monomap/io/nav_grid_export.h"
 #include "monomap/io/trajectory_io.h"
+#include "monomap/localization/localizer.h"
 #include "monomap/pipelines/mapping_pipeline.h"
 #include "monomap/sim/simulate.h"
 #include "tests/monomap_cli.h"
@@ -627,6 +628,22 @@ TEST(CliHelp, BuildShowsTheMappingOptionsDefaults) {
             Shown(o.bundle_adjustment.translation_sigma_fraction));
   EXPECT_EQ(HelpDefault(r.output, "--odometry-span-rotation-sigma-deg"),
             Shown(o.bundle_adjustment.span_rotation_sigma_deg));
+}
+
+TEST(CliHelp, LocalizeShowsTheLocalizerOptionsDefaults) {
+  const RunResult r = RunMonomap("localize --help");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const LocalizerOptions o;
+  EXPECT_EQ(HelpDefault(r.output, "--mcc-top-k"), Shown(o.mcc.top_k))
+      << r.output;
+  EXPECT_EQ(HelpDefault(r.output, "--relocalize-ncc-drop"),
+            Shown(o.recovery.relocalize_ncc_drop));
+  EXPECT_EQ(HelpDefault(r.output, "--seed"), Shown(o.seed));
+  EXPECT_EQ(HelpDefault(r.output, "--mcc-size"),
+            Shown(o.mcc.corrector.width) + "x" + Shown(o.mcc.corrector.height));
+  EXPECT_EQ(
+      HelpDefault(r.output, "--measure-size"),
+      Shown(o.mcl.measurement.width) + "x" + Shown(o.mcl.measurement.height));
 }
 
 TEST(CliHelp, SimulateAndCalibrateShowTheirOptionsDefaults) {
