@@ -42,8 +42,8 @@ Assignment AssignToTruth(const std::vector<TexturedPlane>& truth,
     if (d >= best.distance_m) continue;
     const Eigen::Vector2d st = p.frame.ToPlane(x);
     // A polygon of fewer than 3 vertices bounds nothing: the whole plane.
-    const bool inside = p.polygon.size() < 3 ||
-                        DistanceToPolygon(p.polygon, st) <= margin_m;
+    const bool inside =
+        p.polygon.size() < 3 || DistanceToPolygon(p.polygon, st) <= margin_m;
     if (inside) best = {static_cast<int>(j), d};
   }
   if (best.true_index < 0) best.distance_m = 0.0;
@@ -60,32 +60,27 @@ void ComparePlanes(const Plane& fitted, const Plane& truth, double* angle_deg,
   *offset_m = std::abs(sign * fitted.offset - truth.offset);
 }
 
-}  // namespace
-
-StructureAccuracy EvaluateStructure(const Map& map, const Map& truth,
-                                    const Rigid3d& truth_from_map,
-                                    const StructureAccuracyOptions& options) {
-  options.Check();
-  StructureAccuracy result;
-  result.true_planes = static_cast<int>(truth.planes.size());
-  result.fitted_planes = static_cast<int>(map.planes.size());
-  result.landmarks = static_cast<int>(map.landmarks.size());
-
-  // Points.
-  std::vector<Assignment> assignment(map.landmarks.size());
+// Assigns every landmark to its true plane (`assignment`), counts the
+// landmarks near each true plane (`near_count`) and fills the point errors.
+void ScorePoints(const Map& map, const Map& truth,
+                 const Rigid3d& truth_from_map,
+                 const StructureAccuracyOptions& options,
+                 std::vector<Assignment>* assignment,
+                 std::vector<int>* near_count, StructureAccuracy* result) {
+  assignment->assign(map.landmarks.size(), Assignment());
+  near_count->assign(truth.planes.size(), 0);
   std::vector<double> abs_all, rel_all, abs_on, rel_on;
-  std::vector<int> near_count(truth.planes.size(), 0);
   for (size_t i = 0; i < map.landmarks.size(); ++i) {
     const Landmark& l = map.landmarks[i];
     const Eigen::Vector3d x = truth_from_map * l.x_in_world;
-    assignment[i] = AssignToTruth(truth.planes, x, options.polygon_margin_m);
-    const Assignment& a = assignment[i];
+    (*assignment)[i] = AssignToTruth(truth.planes, x, options.polygon_margin_m);
+    const Assignment& a = (*assignment)[i];
     if (a.true_index < 0) {
-      ++result.landmarks_off_structure;
+      ++result->landmarks_off_structure;
       continue;
     }
     if (a.distance_m <= options.observed_distance_m) {
-      ++near_count[a.true_index];
+      ++(*near_count)[a.true_index];
     }
     const double rel =
         l.mean_depth_m > 0 ? a.distance_m / l.mean_depth_m * 100.0 : 0.0;
@@ -96,48 +91,70 @@ StructureAccuracy EvaluateStructure(const Map& map, const Map& truth,
       rel_on.push_back(rel);
     }
   }
-  result.point_error_all = {ComputeErrorStats(abs_all),
-                            ComputeErrorStats(rel_all)};
-  result.point_error_on_planes = {ComputeErrorStats(abs_on),
-                                  ComputeErrorStats(rel_on)};
+  result->point_error_all = {ComputeErrorStats(abs_all),
+                             ComputeErrorStats(rel_all)};
+  result->point_error_on_planes = {ComputeErrorStats(abs_on),
+                                   ComputeErrorStats(rel_on)};
+}
 
-  // Planes: each fitted plane is compared with the true plane most of its
-  // inliers lie on.
-  result.true_plane_results.resize(truth.planes.size());
-  for (size_t j = 0; j < truth.planes.size(); ++j) {
-    TruePlaneResult& t = result.true_plane_results[j];
-    t.true_id = truth.planes[j].id;
-    t.near_landmarks = near_count[j];
-    t.observed = near_count[j] >= options.min_observed_landmarks;
+// The true plane most of the fitted plane's inliers lie on, or when none
+// does, the closest one; -1 if there is no true plane. Counts the inliers.
+int BestTruePlane(const TexturedPlane& fitted, const Plane& plane,
+                  const Map& map, const Map& truth,
+                  const std::vector<Assignment>& assignment,
+                  const StructureAccuracyOptions& options, int* inliers) {
+  std::vector<int> votes(truth.planes.size(), 0);
+  for (size_t i = 0; i < map.landmarks.size(); ++i) {
+    if (map.landmarks[i].plane_id != fitted.id) continue;
+    ++*inliers;
+    if (assignment[i].true_index >= 0) ++votes[assignment[i].true_index];
   }
+  int best = -1;
+  for (size_t j = 0; j < votes.size(); ++j) {
+    if (votes[j] > 0 && (best < 0 || votes[j] > votes[best])) {
+      best = static_cast<int>(j);
+    }
+  }
+  if (best >= 0) return best;
+  // No inlier on the structure: take the closest plane.
+  double best_cost = std::numeric_limits<double>::infinity();
+  for (size_t j = 0; j < truth.planes.size(); ++j) {
+    double a, o;
+    ComparePlanes(plane, truth.planes[j].plane, &a, &o);
+    const double cost =
+        a / options.max_match_angle_deg + o / options.max_match_offset_m;
+    if (cost < best_cost) best_cost = cost, best = static_cast<int>(j);
+  }
+  return best;
+}
+
+// Keeps on the true plane the best of the fitted planes matched to it.
+void RecordMatch(const PlaneMatch& m, TruePlaneResult* t) {
+  const bool better =
+      t->best_fitted_id < 0 || (m.matched && !t->matched) ||
+      (m.matched == t->matched && m.normal_error_deg < t->normal_error_deg);
+  t->matched = t->matched || m.matched;
+  if (better) {
+    t->best_fitted_id = m.fitted_id;
+    t->normal_error_deg = m.normal_error_deg;
+    t->offset_error_m = m.offset_error_m;
+  }
+}
+
+// Each fitted plane is compared with the true plane most of its inliers lie
+// on; returns the number of fitted planes that match theirs.
+int MatchPlanes(const Map& map, const Map& truth, const Rigid3d& truth_from_map,
+                const StructureAccuracyOptions& options,
+                const std::vector<Assignment>& assignment,
+                StructureAccuracy* result) {
   std::vector<double> normal_errors, offset_errors;
   int matched_fitted = 0;
   for (const TexturedPlane& fitted : map.planes) {
     PlaneMatch m;
     m.fitted_id = fitted.id;
-    std::vector<int> votes(truth.planes.size(), 0);
-    for (size_t i = 0; i < map.landmarks.size(); ++i) {
-      if (map.landmarks[i].plane_id != fitted.id) continue;
-      ++m.inliers;
-      if (assignment[i].true_index >= 0) ++votes[assignment[i].true_index];
-    }
     const Plane plane = fitted.plane.Transformed(truth_from_map);
-    int best = -1;
-    for (size_t j = 0; j < votes.size(); ++j) {
-      if (votes[j] > 0 && (best < 0 || votes[j] > votes[best])) {
-        best = static_cast<int>(j);
-      }
-    }
-    if (best < 0) {  // no inlier on the structure: take the closest plane
-      double best_cost = std::numeric_limits<double>::infinity();
-      for (size_t j = 0; j < truth.planes.size(); ++j) {
-        double a, o;
-        ComparePlanes(plane, truth.planes[j].plane, &a, &o);
-        const double cost = a / options.max_match_angle_deg +
-                            o / options.max_match_offset_m;
-        if (cost < best_cost) best_cost = cost, best = static_cast<int>(j);
-      }
-    }
+    const int best = BestTruePlane(fitted, plane, map, truth, assignment,
+                                   options, &m.inliers);
     if (best >= 0) {
       m.true_id = truth.planes[best].id;
       ComparePlanes(plane, truth.planes[best].plane, &m.normal_error_deg,
@@ -147,22 +164,39 @@ StructureAccuracy EvaluateStructure(const Map& map, const Map& truth,
       normal_errors.push_back(m.normal_error_deg);
       offset_errors.push_back(m.offset_error_m);
       if (m.matched) ++matched_fitted;
-      TruePlaneResult& t = result.true_plane_results[best];
-      const bool better =
-          t.best_fitted_id < 0 || (m.matched && !t.matched) ||
-          (m.matched == t.matched &&
-           m.normal_error_deg < t.normal_error_deg);
-      t.matched = t.matched || m.matched;
-      if (better) {
-        t.best_fitted_id = m.fitted_id;
-        t.normal_error_deg = m.normal_error_deg;
-        t.offset_error_m = m.offset_error_m;
-      }
+      RecordMatch(m, &result->true_plane_results[best]);
     }
-    result.matches.push_back(m);
+    result->matches.push_back(m);
   }
-  result.normal_error_deg = ComputeErrorStats(normal_errors);
-  result.offset_error_m = ComputeErrorStats(offset_errors);
+  result->normal_error_deg = ComputeErrorStats(normal_errors);
+  result->offset_error_m = ComputeErrorStats(offset_errors);
+  return matched_fitted;
+}
+
+}  // namespace
+
+StructureAccuracy EvaluateStructure(const Map& map, const Map& truth,
+                                    const Rigid3d& truth_from_map,
+                                    const StructureAccuracyOptions& options) {
+  options.Check();
+  StructureAccuracy result;
+  result.true_planes = static_cast<int>(truth.planes.size());
+  result.fitted_planes = static_cast<int>(map.planes.size());
+  result.landmarks = static_cast<int>(map.landmarks.size());
+  std::vector<Assignment> assignment;
+  std::vector<int> near_count;
+  ScorePoints(map, truth, truth_from_map, options, &assignment, &near_count,
+              &result);
+
+  result.true_plane_results.resize(truth.planes.size());
+  for (size_t j = 0; j < truth.planes.size(); ++j) {
+    TruePlaneResult& t = result.true_plane_results[j];
+    t.true_id = truth.planes[j].id;
+    t.near_landmarks = near_count[j];
+    t.observed = near_count[j] >= options.min_observed_landmarks;
+  }
+  const int matched_fitted =
+      MatchPlanes(map, truth, truth_from_map, options, assignment, &result);
   int observed_matched = 0;
   for (const TruePlaneResult& t : result.true_plane_results) {
     if (!t.observed) continue;
@@ -173,10 +207,10 @@ StructureAccuracy EvaluateStructure(const Map& map, const Map& truth,
                          ? 0.0
                          : static_cast<double>(matched_fitted) /
                                static_cast<double>(map.planes.size());
-  result.recall = result.observed_true_planes == 0
-                      ? 0.0
-                      : static_cast<double>(observed_matched) /
-                            result.observed_true_planes;
+  result.recall =
+      result.observed_true_planes == 0
+          ? 0.0
+          : static_cast<double>(observed_matched) / result.observed_true_planes;
   return result;
 }
 
@@ -195,8 +229,8 @@ int SetLandmarkDepths(const std::vector<Track>& tracks, Map* map) {
           ok = false;
           break;
         }
-        sum += (l.x_in_world - poses[o.frame].world_from_cam.translation)
-                   .norm();
+        sum +=
+            (l.x_in_world - poses[o.frame].world_from_cam.translation).norm();
       }
     }
     if (ok) {
@@ -204,11 +238,11 @@ int SetLandmarkDepths(const std::vector<Track>& tracks, Map* map) {
       ++from_tracks;
       continue;
     }
-    double nearest = poses.empty() ? 0.0
-                                   : std::numeric_limits<double>::infinity();
+    double nearest =
+        poses.empty() ? 0.0 : std::numeric_limits<double>::infinity();
     for (const TimedPose& p : poses) {
-      nearest = std::min(
-          nearest, (l.x_in_world - p.world_from_cam.translation).norm());
+      nearest = std::min(nearest,
+                         (l.x_in_world - p.world_from_cam.translation).norm());
     }
     l.mean_depth_m = nearest;
   }
