@@ -57,13 +57,13 @@ void RobotPathOptions::Check() const {
               "must be in (0, 5) m/s");
   CheckOption(rate_hz >= 1.0 && rate_hz <= 1000.0, "path.rate_hz",
               "must be in [1, 1000] Hz");
-  CheckOption(std::isfinite(start_time) && start_time >= 0.0,
-              "path.start_time", "must be >= 0");
+  CheckOption(std::isfinite(start_time) && start_time >= 0.0, "path.start_time",
+              "must be >= 0");
   CheckOption(std::isfinite(start_offset_m) && start_offset_m >= 0.0,
               "path.start_offset_m", "must be >= 0");
-  CheckOption(std::isfinite(lateral_offset_m) &&
-                  std::abs(lateral_offset_m) < 5.0,
-              "path.lateral_offset_m", "must be within +-5 m");
+  CheckOption(
+      std::isfinite(lateral_offset_m) && std::abs(lateral_offset_m) < 5.0,
+      "path.lateral_offset_m", "must be within +-5 m");
 }
 
 RobotPath::RobotPath(std::vector<Vector2d> keypoints, bool closed)
@@ -125,96 +125,130 @@ Pose2d RobotPath::PoseAt(double s) const {
   return Pose2d{p.x(), p.y(), std::atan2(tangent.y(), tangent.x())};
 }
 
+namespace {
+
+// Drives a path from a start offset, optionally at a lateral offset: the
+// distance driven -> the pose. A closed path is driven lap after lap.
+struct PathDriver {
+  const RobotPath& path;
+  double length;
+  double start;
+  double lateral_offset_m;
+
+  Pose2d BasePose(double driven) const {
+    double s = start + driven;
+    if (path.closed()) s = std::fmod(s, length);
+    return path.PoseAt(s);
+  }
+  Pose2d OffsetPose(double driven) const {
+    Pose2d p = BasePose(driven);
+    p.x -= lateral_offset_m * std::sin(p.yaw);
+    p.y += lateral_offset_m * std::cos(p.yaw);
+    return p;
+  }
+};
+
+// The samples `driven_length` holds at `step`, or max_samples if positive.
+// An open path ends: more samples than it holds are refused, not cut.
+int SampleCount(bool closed, double step, double driven_length,
+                int max_samples) {
+  const int n = static_cast<int>(std::floor(driven_length / step)) + 1;
+  if (max_samples <= 0) return n;
+  if (max_samples > n && !closed) {
+    throw OptionsError(
+        "num_frames: " + std::to_string(max_samples) + " frames need " +
+        std::to_string((max_samples - 1) * step) +
+        " m of path, but the "
+        "open path has " +
+        std::to_string(driven_length) + " m (at most " + std::to_string(n) +
+        " frames at this speed and rate); lower the "
+        "speed or the number of frames");
+  }
+  return max_samples;
+}
+
+// The parallel curve shares the path's tangents; its arc length differs
+// in turns (ds' = (1 - curvature * d) ds), so tabulate it (distance driven
+// on the path -> on the offset curve) to drive it at constant speed.
+void TabulateOffsetCurve(const PathDriver& driver, double span,
+                         std::vector<double>* table_driven,
+                         std::vector<double>* table_offset) {
+  constexpr double kTableStep = 1e-3;  // m of the path
+  const int m = std::max(1, static_cast<int>(std::ceil(span / kTableStep)));
+  table_driven->assign(m + 1, 0.0);
+  table_offset->assign(m + 1, 0.0);
+  Pose2d prev = driver.OffsetPose(0.0);
+  for (int i = 1; i <= m; ++i) {
+    (*table_driven)[i] = span * i / m;
+    const Pose2d p = driver.OffsetPose((*table_driven)[i]);
+    const Vector2d delta(p.x - prev.x, p.y - prev.y);
+    // Moving forward at less than a tenth of the path's speed: the offset
+    // is (nearly) at the turn's centre.
+    if (delta.dot(Vector2d(std::cos(p.yaw), std::sin(p.yaw))) <
+        0.1 * ((*table_driven)[i] - (*table_driven)[i - 1])) {
+      throw OptionsError(
+          "path.lateral_offset_m: " + std::to_string(driver.lateral_offset_m) +
+          " m reaches the centre of a turn of the path");
+    }
+    (*table_offset)[i] = (*table_offset)[i - 1] + delta.norm();
+    prev = p;
+  }
+}
+
+// The offset curve's pose after `target` m driven along it.
+Pose2d OffsetPoseAt(const PathDriver& driver,
+                    const std::vector<double>& table_driven,
+                    const std::vector<double>& table_offset, double target) {
+  const auto it =
+      std::lower_bound(table_offset.begin(), table_offset.end(), target);
+  const size_t i =
+      std::clamp<size_t>(it - table_offset.begin(), 1, table_offset.size() - 1);
+  const double ds = table_offset[i] - table_offset[i - 1];
+  const double f = ds > 0 ? (target - table_offset[i - 1]) / ds : 0.0;
+  return driver.OffsetPose(table_driven[i - 1] +
+                           f * (table_driven[i] - table_driven[i - 1]));
+}
+
+}  // namespace
+
 std::vector<TimedPose2d> SampleRobotPath(const RobotPath& path,
                                          const RobotPathOptions& options,
                                          int max_samples) {
   options.Check();
   const double length = path.Length();
   if (!path.closed() && !(options.start_offset_m < length)) {
-    throw OptionsError("path.start_offset_m: must be shorter than the open "
-                       "path (" + std::to_string(length) + " m)");
+    throw OptionsError(
+        "path.start_offset_m: must be shorter than the open "
+        "path (" +
+        std::to_string(length) + " m)");
   }
   // Distance driven along the path from the start offset -> path pose.
-  const double start =
-      path.closed() ? std::fmod(options.start_offset_m, length)
-                    : options.start_offset_m;
+  const double start = path.closed() ? std::fmod(options.start_offset_m, length)
+                                     : options.start_offset_m;
   const double span = path.closed() ? length : length - start;
-  // A closed path is driven lap after lap, as long as asked.
-  auto base_pose = [&](double driven) {
-    double s = start + driven;
-    if (path.closed()) s = std::fmod(s, length);
-    return path.PoseAt(s);
-  };
+  const PathDriver driver{path, length, start, options.lateral_offset_m};
   const double step = options.speed_mps / options.rate_hz;
-  // An open path ends: more samples than it holds are refused, not cut.
-  auto sample_count = [&](double driven_length) {
-    const int n = static_cast<int>(std::floor(driven_length / step)) + 1;
-    if (max_samples <= 0) return n;
-    if (max_samples > n && !path.closed()) {
-      throw OptionsError(
-          "num_frames: " + std::to_string(max_samples) + " frames need " +
-          std::to_string((max_samples - 1) * step) +
-          " m of path, but the "
-          "open path has " +
-          std::to_string(driven_length) + " m (at most " + std::to_string(n) +
-          " frames at this speed and rate); lower the "
-          "speed or the number of frames");
-    }
-    return max_samples;
-  };
 
-  const double d = options.lateral_offset_m;
-  if (d == 0.0) {
-    const int n = sample_count(span);
+  if (options.lateral_offset_m == 0.0) {
+    const int n = SampleCount(path.closed(), step, span, max_samples);
     std::vector<TimedPose2d> out(n);
     for (int k = 0; k < n; ++k) {
       out[k].timestamp = options.start_time + k / options.rate_hz;
-      out[k].pose = base_pose(k * step);
+      out[k].pose = driver.BasePose(k * step);
     }
     return out;
   }
 
-  // The parallel curve shares the path's tangents; its arc length differs
-  // in turns (ds' = (1 - curvature * d) ds), so tabulate it to drive it at
-  // constant speed.
-  auto offset_pose = [&](double driven) {
-    Pose2d p = base_pose(driven);
-    p.x -= d * std::sin(p.yaw);
-    p.y += d * std::cos(p.yaw);
-    return p;
-  };
-  constexpr double kTableStep = 1e-3;  // m of the path
-  const int m = std::max(1, static_cast<int>(std::ceil(span / kTableStep)));
-  std::vector<double> table_driven(m + 1), table_offset(m + 1, 0.0);
-  Pose2d prev = offset_pose(0.0);
-  for (int i = 1; i <= m; ++i) {
-    table_driven[i] = span * i / m;
-    const Pose2d p = offset_pose(table_driven[i]);
-    const Vector2d delta(p.x - prev.x, p.y - prev.y);
-    // Moving forward at less than a tenth of the path's speed: the offset
-    // is (nearly) at the turn's centre.
-    if (delta.dot(Vector2d(std::cos(p.yaw), std::sin(p.yaw))) <
-        0.1 * (table_driven[i] - table_driven[i - 1])) {
-      throw OptionsError("path.lateral_offset_m: " + std::to_string(d) +
-                         " m reaches the centre of a turn of the path");
-    }
-    table_offset[i] = table_offset[i - 1] + delta.norm();
-    prev = p;
-  }
-  const int n = sample_count(table_offset[m]);
+  std::vector<double> table_driven, table_offset;
+  TabulateOffsetCurve(driver, span, &table_driven, &table_offset);
+  const double total = table_offset.back();
+  const int n = SampleCount(path.closed(), step, total, max_samples);
   std::vector<TimedPose2d> out(n);
   for (int k = 0; k < n; ++k) {
-    const double target = path.closed() ? std::fmod(k * step, table_offset[m])
-                                        : std::min(k * step, table_offset[m]);
-    const auto it =
-        std::lower_bound(table_offset.begin(), table_offset.end(), target);
-    const size_t i = std::clamp<size_t>(it - table_offset.begin(), 1,
-                                        table_offset.size() - 1);
-    const double ds = table_offset[i] - table_offset[i - 1];
-    const double f = ds > 0 ? (target - table_offset[i - 1]) / ds : 0.0;
+    const double target =
+        path.closed() ? std::fmod(k * step, total) : std::min(k * step, total);
     out[k].timestamp = options.start_time + k / options.rate_hz;
-    out[k].pose = offset_pose(table_driven[i - 1] +
-                              f * (table_driven[i] - table_driven[i - 1]));
+    out[k].pose = OffsetPoseAt(driver, table_driven, table_offset, target);
   }
   return out;
 }
@@ -230,22 +264,21 @@ OdometryNoiseOptions OdometryNoiseOptions::None() {
 }
 
 void OdometryNoiseOptions::Check() const {
-  CheckOption(std::abs(wheel_radius_error) < 0.5,
-              "odometry.wheel_radius_error", "must be within +-0.5");
+  CheckOption(std::abs(wheel_radius_error) < 0.5, "odometry.wheel_radius_error",
+              "must be within +-0.5");
   CheckOption(std::abs(yaw_scale_error) < 0.5, "odometry.yaw_scale_error",
               "must be within +-0.5");
   CheckOption(translation_noise >= 0 && translation_noise < 1.0,
               "odometry.translation_noise", "must be in [0, 1)");
   CheckOption(rotation_noise_per_meter >= 0 && rotation_noise_per_meter < 1.0,
               "odometry.rotation_noise_per_meter", "must be in [0, 1)");
-  CheckOption(
-      rotation_noise_per_radian >= 0 && rotation_noise_per_radian < 1.0,
-      "odometry.rotation_noise_per_radian", "must be in [0, 1)");
+  CheckOption(rotation_noise_per_radian >= 0 && rotation_noise_per_radian < 1.0,
+              "odometry.rotation_noise_per_radian", "must be in [0, 1)");
 }
 
-std::vector<TimedPose2d> SimulateOdometry(
-    const std::vector<TimedPose2d>& truth,
-    const OdometryNoiseOptions& options, uint64_t seed) {
+std::vector<TimedPose2d> SimulateOdometry(const std::vector<TimedPose2d>& truth,
+                                          const OdometryNoiseOptions& options,
+                                          uint64_t seed) {
   options.Check();
   std::vector<TimedPose2d> odom;
   if (truth.empty()) return odom;
@@ -266,11 +299,11 @@ std::vector<TimedPose2d> SimulateOdometry(
     Vector2d dir = dist > 0 ? Vector2d(dp / dist) : Vector2d(1.0, 0.0);
     dp = dp * (1.0 + options.wheel_radius_error) +
          dir * (options.translation_noise * std::sqrt(dist) * n_t);
-    const double rot_sigma = std::sqrt(
-        options.rotation_noise_per_meter * options.rotation_noise_per_meter *
-            dist +
-        options.rotation_noise_per_radian * options.rotation_noise_per_radian *
-            std::abs(dyaw));
+    const double rot_sigma =
+        std::sqrt(options.rotation_noise_per_meter *
+                      options.rotation_noise_per_meter * dist +
+                  options.rotation_noise_per_radian *
+                      options.rotation_noise_per_radian * std::abs(dyaw));
     dyaw = dyaw * (1.0 + options.yaw_scale_error) + rot_sigma * n_r;
     const Vector2d step = Rot2(yaw) * dp;
     x += step.x();

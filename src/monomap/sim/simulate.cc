@@ -29,17 +29,17 @@ void SimulationOptions::Check() const {
               "sim.focal_px_at_640", "must be in (50, 5000)");
   CheckOption(std::abs(k1) < 1.0 && std::abs(k2) < 1.0, "sim.k1/k2",
               "must be within +-1");
-  CheckOption(texture_pixels_per_meter >= 20 &&
-                  texture_pixels_per_meter <= 2000,
-              "sim.texture_pixels_per_meter", "must be in [20, 2000]");
+  CheckOption(
+      texture_pixels_per_meter >= 20 && texture_pixels_per_meter <= 2000,
+      "sim.texture_pixels_per_meter", "must be in [20, 2000]");
   path.Check();
   mount.Check();
   odometry.Check();
   render.Check();
   effects.Check();
-  CheckOption(moving_object_start_fraction >= 0 &&
-                  moving_object_start_fraction <= 1,
-              "sim.moving_object_start_fraction", "must be in [0, 1]");
+  CheckOption(
+      moving_object_start_fraction >= 0 && moving_object_start_fraction <= 1,
+      "sim.moving_object_start_fraction", "must be in [0, 1]");
   CheckOption(moving_object_duration_fraction > 0 &&
                   moving_object_duration_fraction <= 1,
               "sim.moving_object_duration_fraction", "must be in (0, 1]");
@@ -90,6 +90,113 @@ std::vector<TimedPose> CameraPoses(const std::vector<TimedPose2d>& base,
   return out;
 }
 
+// Frame count, structure size and the odometry's drift at the end.
+void FillPathReport(const World& world, const std::vector<TimedPose2d>& truth,
+                    const std::vector<TimedPose2d>& odom,
+                    SimulationReport* report) {
+  report->frames = static_cast<int>(truth.size());
+  report->planes = static_cast<int>(world.planes.size());
+  report->texture_megabytes = world.TextureBytes() / 1e6;
+  report->path_length_m = PathLength(truth);
+  const Pose2d& a = truth.back().pose;
+  const Pose2d& b = odom.back().pose;
+  report->final_drift_m = std::hypot(a.x - b.x, a.y - b.y);
+  report->final_drift_percent =
+      report->path_length_m > 0
+          ? 100.0 * report->final_drift_m / report->path_length_m
+          : 0.0;
+  report->final_yaw_error_deg =
+      std::abs(std::remainder(a.yaw - b.yaw, 2.0 * M_PI)) * 180.0 / M_PI;
+}
+
+// Adds the (hidden) moving disc and its frame span to the report; returns
+// its plane index.
+int AddMovingObject(const SimulationOptions& options, int n,
+                    SceneRenderer* renderer, SimulationReport* report) {
+  const int object_index = renderer->AddPlane(MakeDiscObject(
+      options.moving_object_radius_m, options.texture_pixels_per_meter,
+      SimMixSeed(options.seed, 77)));
+  renderer->SetPlaneVisible(object_index, false);
+  report->moving_object_first_frame = std::min(
+      n - 1, static_cast<int>(options.moving_object_start_fraction * n));
+  report->moving_object_last_frame = std::min(
+      n - 1, report->moving_object_first_frame +
+                 std::max(0, static_cast<int>(
+                                 options.moving_object_duration_fraction * n) -
+                                 1));
+  return object_index;
+}
+
+// Shows the moving disc in frame i (facing the camera, sweeping across the
+// middle 70% of `half_width`) while it is present.
+void PlaceMovingObject(const SimulationOptions& options,
+                       const SimulationReport& report, int object_index, int i,
+                       const Rigid3d& world_from_cam, double half_width,
+                       SceneRenderer* renderer) {
+  const int f0 = report.moving_object_first_frame;
+  const int f1 = report.moving_object_last_frame;
+  const bool present = i >= f0 && i <= f1;
+  renderer->SetPlaneVisible(object_index, present);
+  if (!present) return;
+  const double u = f1 > f0 ? static_cast<double>(i - f0) / (f1 - f0) : 0.5;
+  const Eigen::Vector3d centre_in_cam((2.0 * u - 1.0) * 0.7 * half_width, 0.05,
+                                      options.moving_object_distance_m);
+  const Eigen::Vector3d centre = world_from_cam * centre_in_cam;
+  Plane plane;
+  PlaneFrame frame;
+  PlaceDisc(options.moving_object_radius_m, centre,
+            world_from_cam.translation - centre, &plane, &frame);
+  renderer->SetPlanePose(object_index, plane, frame);
+}
+
+// The lights' specular reflections on the floor seen from the camera.
+std::vector<SceneRenderer::Highlight> FloorHighlights(
+    const SimulationOptions& options, const World& world,
+    const Rigid3d& world_from_cam) {
+  std::vector<SceneRenderer::Highlight> highlights;
+  if (!options.specular_highlight || world.floor_plane < 0) return highlights;
+  for (const Eigen::Vector3d& light : world.lights) {
+    SceneRenderer::Highlight h;
+    if (!SpecularPoint(light, world_from_cam.translation, 0.0, &h.centre)) {
+      continue;
+    }
+    h.plane_index = world.floor_plane;
+    h.radius_m = options.highlight_radius_m;
+    h.strength = options.highlight_strength;
+    highlights.push_back(h);
+  }
+  return highlights;
+}
+
+// Writes camera.yaml, camera_mount.yaml and the odometry and ground truth
+// files into the dataset directory `root`.
+void WriteDatasetFiles(const fs::path& root, const Camera& camera,
+                       const World& world, const Rigid3d& base_from_cam,
+                       const std::vector<TimedPose2d>& odom,
+                       const std::vector<TimedPose>& odom_cam,
+                       const std::vector<TimedPose>& gt_cam) {
+  WriteCameraYaml(root / "camera.yaml", camera, "monomap_sim_" + world.name);
+  WriteCameraMountYaml(root / "camera_mount.yaml", base_from_cam);
+  WriteFileAtomic(root / "odometry2d.txt", FormatOdometry2d(odom));
+  WriteTumTrajectory(root / "odometry.txt", odom_cam,
+                     "simulated wheel odometry composed with the mount");
+  WriteTumTrajectory(root / "groundtruth.txt", gt_cam,
+                     "simulated ground truth (" + world.name + ")");
+}
+
+// Writes frame i's image as rgb/NNNNNN.png and appends its line to rgb.txt.
+void WriteFrame(const fs::path& root, int i, double timestamp,
+                const cv::Mat& image, std::ostringstream* rgb_list) {
+  char name[32];
+  std::snprintf(name, sizeof(name), "rgb/%06d.png", i);
+  if (!cv::imwrite((root / name).string(), image)) {
+    throw OutputError((root / name).string() + ": cannot write image");
+  }
+  char line[96];
+  std::snprintf(line, sizeof(line), "%.6f %s\n", timestamp, name);
+  *rgb_list << line;
+}
+
 }  // namespace
 
 SimulationReport Simulate(const SimulationOptions& options,
@@ -99,8 +206,8 @@ SimulationReport Simulate(const SimulationOptions& options,
   SimulationReport report;
   report.world = options.world;
 
-  const World world = MakeWorld(options.world, options.seed,
-                                options.texture_pixels_per_meter);
+  const World world =
+      MakeWorld(options.world, options.seed, options.texture_pixels_per_meter);
   const Camera camera = MakeSimulationCamera(options);
   const RobotPath path(world);
   const std::vector<TimedPose2d> truth =
@@ -112,50 +219,19 @@ SimulationReport Simulate(const SimulationOptions& options,
   const Rigid3d base_from_cam = MakeCameraMount(options.mount);
   const std::vector<TimedPose> gt_cam = CameraPoses(truth, base_from_cam);
   const std::vector<TimedPose> odom_cam = CameraPoses(odom, base_from_cam);
-
-  const int n = static_cast<int>(truth.size());
-  report.frames = n;
-  report.planes = static_cast<int>(world.planes.size());
-  report.texture_megabytes = world.TextureBytes() / 1e6;
-  report.path_length_m = PathLength(truth);
-  const Pose2d& a = truth.back().pose;
-  const Pose2d& b = odom.back().pose;
-  report.final_drift_m = std::hypot(a.x - b.x, a.y - b.y);
-  report.final_drift_percent =
-      report.path_length_m > 0
-          ? 100.0 * report.final_drift_m / report.path_length_m
-          : 0.0;
-  report.final_yaw_error_deg =
-      std::abs(std::remainder(a.yaw - b.yaw, 2.0 * M_PI)) * 180.0 / M_PI;
+  FillPathReport(world, truth, odom, &report);
+  const int n = report.frames;
 
   SceneRenderer renderer(camera, options.render);
   for (const TexturedPlane& p : world.planes) renderer.AddPlane(p);
-  int object_index = -1;
-  if (options.moving_object) {
-    object_index = renderer.AddPlane(
-        MakeDiscObject(options.moving_object_radius_m,
-                       options.texture_pixels_per_meter,
-                       SimMixSeed(options.seed, 77)));
-    renderer.SetPlaneVisible(object_index, false);
-    report.moving_object_first_frame = std::min(
-        n - 1, static_cast<int>(options.moving_object_start_fraction * n));
-    report.moving_object_last_frame = std::min(
-        n - 1, report.moving_object_first_frame +
-                   std::max(0, static_cast<int>(
-                                   options.moving_object_duration_fraction * n) -
-                                   1));
-  }
+  const int object_index = options.moving_object
+                               ? AddMovingObject(options, n, &renderer, &report)
+                               : -1;
 
   AtomicDirectory dir(out_dir, "dataset");
   const fs::path root = dir.path();
   fs::create_directories(root / "rgb");
-  WriteCameraYaml(root / "camera.yaml", camera, "monomap_sim_" + world.name);
-  WriteCameraMountYaml(root / "camera_mount.yaml", base_from_cam);
-  WriteFileAtomic(root / "odometry2d.txt", FormatOdometry2d(odom));
-  WriteTumTrajectory(root / "odometry.txt", odom_cam,
-                     "simulated wheel odometry composed with the mount");
-  WriteTumTrajectory(root / "groundtruth.txt", gt_cam,
-                     "simulated ground truth (" + world.name + ")");
+  WriteDatasetFiles(root, camera, world, base_from_cam, odom, odom_cam, gt_cam);
 
   // Half the horizontal field of view at the object distance: the object
   // sweeps over the middle 70% of it (further out it would often hide
@@ -168,50 +244,15 @@ SimulationReport Simulate(const SimulationOptions& options,
   for (int i = 0; i < n; ++i) {
     const Rigid3d& world_from_cam = gt_cam[i].world_from_cam;
     if (object_index >= 0) {
-      const int f0 = report.moving_object_first_frame;
-      const int f1 = report.moving_object_last_frame;
-      const bool present = i >= f0 && i <= f1;
-      renderer.SetPlaneVisible(object_index, present);
-      if (present) {
-        const double u = f1 > f0 ? static_cast<double>(i - f0) / (f1 - f0)
-                                 : 0.5;
-        const Eigen::Vector3d centre_in_cam(
-            (2.0 * u - 1.0) * 0.7 * half_width, 0.05,
-            options.moving_object_distance_m);
-        const Eigen::Vector3d centre = world_from_cam * centre_in_cam;
-        Plane plane;
-        PlaneFrame frame;
-        PlaceDisc(options.moving_object_radius_m, centre,
-                  world_from_cam.translation - centre, &plane, &frame);
-        renderer.SetPlanePose(object_index, plane, frame);
-      }
+      PlaceMovingObject(options, report, object_index, i, world_from_cam,
+                        half_width, &renderer);
     }
-    std::vector<SceneRenderer::Highlight> highlights;
-    if (options.specular_highlight && world.floor_plane >= 0) {
-      for (const Eigen::Vector3d& light : world.lights) {
-        SceneRenderer::Highlight h;
-        if (!SpecularPoint(light, world_from_cam.translation, 0.0,
-                           &h.centre)) {
-          continue;
-        }
-        h.plane_index = world.floor_plane;
-        h.radius_m = options.highlight_radius_m;
-        h.strength = options.highlight_strength;
-        highlights.push_back(h);
-      }
-    }
-    const cv::Mat radiance = renderer.Render(world_from_cam, highlights);
+    const cv::Mat radiance = renderer.Render(
+        world_from_cam, FloorHighlights(options, world, world_from_cam));
     const cv::Mat image = ApplyCameraEffects(
         radiance, truth[i].timestamp - truth[0].timestamp, options.effects,
         run_seed, SimMixSeed(run_seed, 1000000 + i));
-    char name[32];
-    std::snprintf(name, sizeof(name), "rgb/%06d.png", i);
-    if (!cv::imwrite((root / name).string(), image)) {
-      throw OutputError((root / name).string() + ": cannot write image");
-    }
-    char line[96];
-    std::snprintf(line, sizeof(line), "%.6f %s\n", truth[i].timestamp, name);
-    rgb_list << line;
+    WriteFrame(root, i, truth[i].timestamp, image, &rgb_list);
     progress.Advance();
   }
   progress.Finish();
