@@ -197,6 +197,39 @@ void WriteFrame(const fs::path& root, int i, double timestamp,
   *rgb_list << line;
 }
 
+// Renders every frame from its true pose into root/rgb and writes rgb.txt.
+void RenderFrames(const SimulationOptions& options, const World& world,
+                  const Camera& camera, const std::vector<TimedPose2d>& truth,
+                  const std::vector<TimedPose>& gt_cam, uint64_t run_seed,
+                  const SimulationReport& report, int object_index,
+                  const fs::path& root, SceneRenderer* renderer) {
+  const int n = static_cast<int>(truth.size());
+  // Half the horizontal field of view at the object distance: the object
+  // sweeps over the middle 70% of it (further out it would often hide
+  // behind nearby walls).
+  const double half_width =
+      options.moving_object_distance_m * (camera.width * 0.5) / camera.fx;
+  std::ostringstream rgb_list;
+  rgb_list << "# timestamp filename (simulated " << world.name << ")\n";
+  ProgressBar progress("simulate " + world.name, n, options.show_progress);
+  for (int i = 0; i < n; ++i) {
+    const Rigid3d& world_from_cam = gt_cam[i].world_from_cam;
+    if (object_index >= 0) {
+      PlaceMovingObject(options, report, object_index, i, world_from_cam,
+                        half_width, renderer);
+    }
+    const cv::Mat radiance = renderer->Render(
+        world_from_cam, FloorHighlights(options, world, world_from_cam));
+    const cv::Mat image = ApplyCameraEffects(
+        radiance, truth[i].timestamp - truth[0].timestamp, options.effects,
+        run_seed, SimMixSeed(run_seed, 1000000 + i));
+    WriteFrame(root, i, truth[i].timestamp, image, &rgb_list);
+    progress.Advance();
+  }
+  progress.Finish();
+  WriteFileAtomic(root / "rgb.txt", rgb_list.str());
+}
+
 }  // namespace
 
 SimulationReport Simulate(const SimulationOptions& options,
@@ -233,30 +266,8 @@ SimulationReport Simulate(const SimulationOptions& options,
   fs::create_directories(root / "rgb");
   WriteDatasetFiles(root, camera, world, base_from_cam, odom, odom_cam, gt_cam);
 
-  // Half the horizontal field of view at the object distance: the object
-  // sweeps over the middle 70% of it (further out it would often hide
-  // behind nearby walls).
-  const double half_width =
-      options.moving_object_distance_m * (camera.width * 0.5) / camera.fx;
-  std::ostringstream rgb_list;
-  rgb_list << "# timestamp filename (simulated " << world.name << ")\n";
-  ProgressBar progress("simulate " + world.name, n, options.show_progress);
-  for (int i = 0; i < n; ++i) {
-    const Rigid3d& world_from_cam = gt_cam[i].world_from_cam;
-    if (object_index >= 0) {
-      PlaceMovingObject(options, report, object_index, i, world_from_cam,
-                        half_width, &renderer);
-    }
-    const cv::Mat radiance = renderer.Render(
-        world_from_cam, FloorHighlights(options, world, world_from_cam));
-    const cv::Mat image = ApplyCameraEffects(
-        radiance, truth[i].timestamp - truth[0].timestamp, options.effects,
-        run_seed, SimMixSeed(run_seed, 1000000 + i));
-    WriteFrame(root, i, truth[i].timestamp, image, &rgb_list);
-    progress.Advance();
-  }
-  progress.Finish();
-  WriteFileAtomic(root / "rgb.txt", rgb_list.str());
+  RenderFrames(options, world, camera, truth, gt_cam, run_seed, report,
+               object_index, root, &renderer);
 
   if (options.write_structure) {
     Map structure;
