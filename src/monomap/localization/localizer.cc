@@ -158,11 +158,16 @@ void Localizer::InitializeGlobal(const std::optional<Rigid3d>& reference) {
 }
 
 void Localizer::InitializeAtPose(const Rigid3d& world_from_cam) {
+  InitializeAtPose(world_from_cam, options_.init.spread_m,
+                   options_.init.spread_deg);
+}
+
+void Localizer::InitializeAtPose(const Rigid3d& world_from_cam,
+                                 double spread_m, double spread_deg) {
   // Injection in 6-DoF keeps the height and tilt of this pose.
   if (!reference_) reference_ = world_from_cam;
   particles_ = state_->AroundPose(world_from_cam, options_.mcl.num_particles,
-                                  options_.init.spread_m,
-                                  options_.init.spread_deg * kDegToRad, &rng_);
+                                  spread_m, spread_deg * kDegToRad, &rng_);
   first_step_ = true;
   recovery_.Reset();
 }

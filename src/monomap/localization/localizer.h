@@ -134,8 +134,11 @@ class Localizer {
   // floor. 6-DoF: height, roll and pitch of a random map trajectory pose
   // (or of `reference` if given).
   void InitializeGlobal(const std::optional<Rigid3d>& reference = {});
-  // Particles around world_from_cam with options' spread.
+  // Particles around world_from_cam with options' spread, or with the
+  // given one (m, degrees; e.g. from rviz's "2D Pose Estimate").
   void InitializeAtPose(const Rigid3d& world_from_cam);
+  void InitializeAtPose(const Rigid3d& world_from_cam, double spread_m,
+                        double spread_deg);
   // The initialization options.init asks for. `odometry_pose` (a
   // sequence's first odometry pose): the start of a pose init without
   // options.init.pose, and the 6-DoF height and tilt reference of a global

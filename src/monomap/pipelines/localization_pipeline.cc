@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "monomap/io/map_format.h"
 #include "monomap/util/error.h"
 #include "monomap/util/progress.h"
 
@@ -64,16 +65,15 @@ void CheckDatasetForState(const Dataset& dataset, LocalizationState state) {
   }
 }
 
-OdometryIncrement IncrementBetween(const DatasetFrame& prev,
-                                   const DatasetFrame& cur, bool planar) {
-  OdometryIncrement odometry;
-  odometry.cam_prev_from_cam_cur =
-      prev.odometry_world_from_cam.Inverse() * cur.odometry_world_from_cam;
-  if (planar) {
-    odometry.base_prev = *prev.odometry_base;
-    odometry.base_cur = *cur.odometry_base;
-  }
-  return odometry;
+// A dataset frame as a live robot would give it to the session.
+SessionFrame FrameOf(const Dataset& dataset, size_t i) {
+  const DatasetFrame& f = dataset.frames[i];
+  SessionFrame frame;
+  frame.stamp = f.timestamp;
+  frame.image = dataset.LoadImage(i);
+  frame.odom_from_cam = f.odometry_world_from_cam;
+  frame.odom_base = f.odometry_base;
+  return frame;
 }
 
 // The errors of the estimates against the frames' ground truth, computed
@@ -111,12 +111,15 @@ LocalizationReport LocalizeSequence(
     std::vector<std::vector<Particle>>* particle_sets) {
   options.Check();
   if (dataset.frames.empty()) throw InputError("localization: no frames");
-  const LocalizerOptions& lo = options.localizer;
-  const bool planar = lo.state == LocalizationState::kPlanar;
-  CheckDatasetForState(dataset, lo.state);
+  CheckDatasetForState(dataset, options.localizer.state);
   const Timer timer;
-  Localizer localizer(map, dataset.camera, lo, dataset.base_from_cam);
-  localizer.Initialize(dataset.frames.front().odometry_world_from_cam);
+  // The session is what a live robot runs; the caller keeps `map` alive.
+  SessionOptions session_options;
+  session_options.localizer = options.localizer;
+  session_options.output_particles = particle_sets != nullptr;
+  LocalizationSession session(
+      std::shared_ptr<const Map>(&map, [](const Map*) {}), dataset.camera,
+      session_options, dataset.base_from_cam);
 
   LocalizationReport report;
   std::vector<TimedPose> estimate;
@@ -124,17 +127,13 @@ LocalizationReport LocalizeSequence(
   ProgressBar progress("localize", dataset.frames.size(),
                        options.show_progress);
   for (size_t i = 0; i < dataset.frames.size(); ++i) {
-    const DatasetFrame& f = dataset.frames[i];
-    const OdometryIncrement odometry =
-        i > 0 ? IncrementBetween(dataset.frames[i - 1], f, planar)
-              : OdometryIncrement();
-    const LocalizerEstimate e = localizer.Step(dataset.LoadImage(i), odometry);
-    estimate.push_back({f.timestamp, e.world_from_cam});
-    if (particle_sets) particle_sets->push_back(localizer.particles());
-    report.steps.push_back(e.stats);
-    report.mean_step_seconds += e.stats.seconds;
-    report.mean_particles += e.stats.particles;
-    report.mcc_accepted += e.stats.mcc_accepted;
+    SessionResult r = session.Process(FrameOf(dataset, i));
+    estimate.push_back({r.stamp, r.world_from_cam});
+    if (particle_sets) particle_sets->push_back(std::move(r.particles));
+    report.steps.push_back(r.stats);
+    report.mean_step_seconds += r.stats.seconds;
+    report.mean_particles += r.stats.particles;
+    report.mcc_accepted += r.stats.mcc_accepted;
     progress.Advance();
   }
   progress.Finish();
@@ -145,6 +144,16 @@ LocalizationReport LocalizeSequence(
   if (trajectory) *trajectory = std::move(estimate);
   report.seconds = timer.ElapsedSeconds();
   return report;
+}
+
+std::unique_ptr<LocalizationSession> OpenLocalizationSession(
+    const std::filesystem::path& map_dir, const SessionOptions& options,
+    const std::optional<Camera>& live_camera,
+    const std::optional<Rigid3d>& base_from_cam) {
+  auto map = std::make_shared<const Map>(ReadMap(map_dir));
+  const Camera camera = live_camera ? *live_camera : map->camera;
+  return std::make_unique<LocalizationSession>(std::move(map), camera,
+                                               options, base_from_cam);
 }
 
 }  // namespace monomap

@@ -4,12 +4,16 @@
 // the errors (eval/localization_accuracy.h).
 #pragma once
 
+#include <filesystem>
+#include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <vector>
 
 #include "monomap/eval/localization_accuracy.h"
 #include "monomap/io/dataset.h"
 #include "monomap/localization/localizer.h"
+#include "monomap/localization/session.h"
 #include "monomap/map/map.h"
 
 namespace monomap {
@@ -60,5 +64,13 @@ LocalizationReport LocalizeSequence(
     const LocalizationPipelineOptions& options,
     std::vector<TimedPose>* trajectory,
     std::vector<std::vector<Particle>>* particle_sets = nullptr);
+
+// A streaming session over the map in `map_dir` (io/map_format.h), for a
+// live robot. `live_camera`: the camera the images come from; empty: the
+// map's camera. Throws InputError if the map does not load.
+std::unique_ptr<LocalizationSession> OpenLocalizationSession(
+    const std::filesystem::path& map_dir, const SessionOptions& options,
+    const std::optional<Camera>& live_camera = {},
+    const std::optional<Rigid3d>& base_from_cam = {});
 
 }  // namespace monomap

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
 
+#include "monomap/io/map_format.h"
 #include "monomap/localization/test_scene.h"
 #include "monomap/util/error.h"
 
@@ -149,6 +150,34 @@ TEST_F(LocalizationPipelineTest, PlanarStateNeedsTheMountAnd2dOdometry) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("odometry2d.txt"), std::string::npos);
   }
+}
+
+TEST_F(LocalizationPipelineTest, SessionFromAMapDirectoryReplaysLikeLocalize) {
+  // What a robot does: open the written map, feed the frames one by one.
+  // It must give what `monomap localize` (LocalizeSequence) gives.
+  const std::filesystem::path map_dir = dir_ / "map";
+  std::filesystem::create_directories(map_dir);
+  map_.camera = ds_.camera.Pinhole();
+  WriteMap(map_dir, map_);
+  LocalizationPipelineOptions o = Mcc200();
+  std::vector<TimedPose> expected;
+  LocalizeSequence(ReadMap(map_dir), ds_, o, &expected);
+  SessionOptions so;
+  so.localizer = o.localizer;
+  const std::unique_ptr<LocalizationSession> session =
+      OpenLocalizationSession(map_dir, so, ds_.camera, ds_.base_from_cam);
+  for (size_t i = 0; i < ds_.frames.size(); ++i) {
+    SessionFrame f;
+    f.stamp = ds_.frames[i].timestamp;
+    f.image = ds_.LoadImage(i);
+    f.odom_from_cam = ds_.frames[i].odometry_world_from_cam;
+    f.odom_base = ds_.frames[i].odometry_base;
+    const SessionResult r = session->Process(f);
+    EXPECT_EQ(r.world_from_cam.translation,
+              expected[i].world_from_cam.translation)
+        << "frame " << i;
+  }
+  EXPECT_THROW(OpenLocalizationSession(dir_ / "no_map", so), InputError);
 }
 
 }  // namespace
