@@ -652,6 +652,12 @@ TEST(CliHelp, SimulateAndCalibrateShowTheirOptionsDefaults) {
   const SimulationOptions s;
   EXPECT_EQ(HelpDefault(sim.output, "--width"), Shown(s.width)) << sim.output;
   EXPECT_EQ(HelpDefault(sim.output, "--speed"), Shown(s.path.speed_mps));
+  EXPECT_EQ(HelpDefault(sim.output, "--fps"), Shown(s.path.rate_hz));
+  EXPECT_EQ(HelpDefault(sim.output, "--camera-height"),
+            Shown(s.mount.height_m));
+  EXPECT_EQ(HelpDefault(sim.output, "--camera-tilt"),
+            Shown(s.mount.tilt_down_deg));
+  EXPECT_EQ(HelpDefault(sim.output, "--k1"), Shown(s.k1));
   const RunResult cal = RunMonomap("calibrate --help");
   ASSERT_EQ(cal.exit_code, 0) << cal.output;
   const CalibrationOptions c;

@@ -50,6 +50,21 @@ void RegisterSimulateCommand(CLI::App& app) {
   cmd->add_option("--height", o->height, "Image height")->capture_default_str();
   cmd->add_option("--speed", o->path.speed_mps, "Robot speed (m/s)")
       ->capture_default_str();
+  cmd->add_option("--fps", o->path.rate_hz, "Camera and odometry rate (Hz)")
+      ->capture_default_str();
+  cmd->add_option("--camera-height", o->mount.height_m,
+                  "Height of the camera above the floor (m)")
+      ->capture_default_str();
+  cmd->add_option("--camera-tilt", o->mount.tilt_down_deg,
+                  "Downward pitch of the camera (degrees)")
+      ->capture_default_str();
+  cmd->add_option("--focal", o->focal_px_at_640,
+                  "Focal length (pixels, for a 640-pixel-wide image)")
+      ->capture_default_str();
+  cmd->add_option("--k1", o->k1, "Radial distortion k1 (plumb_bob)")
+      ->capture_default_str();
+  cmd->add_option("--k2", o->k2, "Radial distortion k2 (plumb_bob)")
+      ->capture_default_str();
   cmd->add_option("--odometry-scale-error", o->odometry.wheel_radius_error,
                   "Systematic wheel radius error (fraction)")
       ->capture_default_str();

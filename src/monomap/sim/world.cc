@@ -7,6 +7,7 @@
 
 #include <tbb/parallel_for.h>
 
+#include "monomap/geometry/polygon.h"
 #include "monomap/util/error.h"
 
 namespace monomap {
@@ -404,6 +405,31 @@ void PaintBoxFace(TexturedPlane* plane, bool metal, cv::RNG* rng) {
   cv::cvtColor(bgr, plane->texture, cv::COLOR_BGR2BGRA);
 }
 
+// A door leaf filling its whole texture (a recessed door is its own
+// plane, behind the wall's opening).
+void PaintDoorLeaf(TexturedPlane* plane, double width, double height,
+                   cv::RNG* rng) {
+  cv::Mat img(plane->texture.size(), CV_32FC3);
+  Painter p(&img, plane->pixels_per_meter, rng);
+  img.setTo(cv::Scalar(50, 50, 55));
+  p.Door(0.0, height, width, height);
+  cv::Mat bgr;
+  img.convertTo(bgr, CV_8UC3);
+  cv::cvtColor(bgr, plane->texture, cv::COLOR_BGR2BGRA);
+}
+
+// Painted wooden trim (door jambs and lintel soffits): one colour, fine
+// grain.
+void PaintTrim(TexturedPlane* plane, cv::RNG* rng) {
+  cv::Mat img(plane->texture.size(), CV_32FC3);
+  Painter p(&img, plane->pixels_per_meter, rng);
+  img.setTo(p.Colour(150, 200));
+  p.AddNoise({0, 0, img.cols, img.rows}, 6.0, 0.02, 1.0 / p.ppm());
+  cv::Mat bgr;
+  img.convertTo(bgr, CV_8UC3);
+  cv::cvtColor(bgr, plane->texture, cv::COLOR_BGR2BGRA);
+}
+
 // Vertical rectangle from floor point a to b, z in [z0, z1], with its
 // normal towards the left of a->b (the side it is seen from). Seen from
 // there, u points right and v up, so the texture is not mirrored: its rows
@@ -473,6 +499,58 @@ class WorldBuilder {
     }
     Add(HorizontalRect(NextId(), x0, x1, y0, y1, h, true, ppm_), paint);
   }
+  // A wall from a to b with doors recessed `depth` behind it: the wall's
+  // polygon has a notch at each opening (`door_s`: distances from b, in
+  // the texture's s), and each door adds its leaf, two jambs and a soffit.
+  void WallWithDoors(const Vector2d& a, const Vector2d& b, double h,
+                     const std::vector<double>& door_s, int posters,
+                     double door_w, double door_h, double depth) {
+    const double width = (b - a).norm();
+    TexturedPlane wall = VerticalRect(NextId(), a, b, 0.0, h, ppm_);
+    WallDecor decor{0, posters, {}};
+    wall.polygon = {{0.0, 0.0}};
+    for (const double s0 : door_s) {
+      wall.polygon.insert(wall.polygon.end(), {{s0, 0.0}, {s0, door_h},
+                                               {s0 + door_w, door_h},
+                                               {s0 + door_w, 0.0}});
+      decor.keep_free.push_back({s0, s0 + door_w});
+    }
+    wall.polygon.insert(wall.polygon.end(), {{width, 0.0}, {width, h},
+                                             {0.0, h}});
+    Add(std::move(wall), [width, h, decor](TexturedPlane* p, cv::RNG* rng) {
+      PaintWall(p, width, h, decor, rng);
+    });
+    const Vector2d u = (a - b).normalized();
+    const Vector2d n(u.y(), -u.x());  // left of a -> b: the wall's normal
+    for (const double s0 : door_s) {
+      Door(b + s0 * u, b + (s0 + door_w) * u, -depth * n, door_h);
+    }
+  }
+  // An axis-aligned floor or ceiling whose extent is `polygon` (x, y),
+  // within the rectangle [x0, x1] x [y0, y1] of its texture.
+  void FloorPolygon(double x0, double x1, double y0, double y1,
+                    const std::vector<Vector2d>& polygon_xy) {
+    world_.floor_plane = NextId();
+    TexturedPlane plane = HorizontalRect(NextId(), x0, x1, y0, y1, 0.0, true,
+                                         ppm_);
+    SetPolygonXy(&plane, polygon_xy);
+    Add(std::move(plane), [=](TexturedPlane* p, cv::RNG* rng) {
+      PaintFloor(p, x1 - x0, y1 - y0, false, rng);
+    });
+  }
+  void CeilingPolygon(double x0, double x1, double y0, double y1, double z,
+                      const std::vector<Vector2d>& polygon_xy) {
+    TexturedPlane plane =
+        HorizontalRect(NextId(), x0, x1, y0, y1, z, false, ppm_);
+    SetPolygonXy(&plane, polygon_xy);
+    std::vector<Vector2d> lights_st;
+    for (const Vector3d& l : world_.lights) {
+      lights_st.push_back(plane.frame.ToPlane(Vector3d(l.x(), l.y(), z)));
+    }
+    Add(std::move(plane), [lights_st](TexturedPlane* p, cv::RNG* rng) {
+      PaintCeiling(p, lights_st, rng);
+    });
+  }
   void Whiteboard(const Vector2d& a, const Vector2d& b, double z0,
                   double z1) {
     Add(VerticalRect(NextId(), a, b, z0, z1, ppm_),
@@ -492,6 +570,49 @@ class WorldBuilder {
  private:
   using Job = std::function<void(TexturedPlane*, cv::RNG*)>;
   int NextId() const { return static_cast<int>(world_.planes.size()); }
+  // The opening p0 -> p1 (on the wall line) of a door recessed by
+  // `behind` (a floor vector pointing away from the corridor): the leaf
+  // faces the corridor like its wall, the jambs face the opening's
+  // middle, the soffit faces down.
+  void Door(const Vector2d& p0, const Vector2d& p1, const Vector2d& behind,
+            double door_h) {
+    const double door_w = (p1 - p0).norm();
+    Add(VerticalRect(NextId(), p1 + behind, p0 + behind, 0.0, door_h, ppm_),
+        [door_w, door_h](TexturedPlane* p, cv::RNG* rng) {
+          PaintDoorLeaf(p, door_w, door_h, rng);
+        });
+    auto trim = [](TexturedPlane* p, cv::RNG* rng) { PaintTrim(p, rng); };
+    const Vector2d along = (p1 - p0).normalized();
+    Add(VerticalRectFacing(p0, p0 + behind, along, door_h), trim);
+    Add(VerticalRectFacing(p1, p1 + behind, -along, door_h), trim);
+    const Vector2d lo = p0.cwiseMin(p1).cwiseMin(p0 + behind);
+    const Vector2d hi = p0.cwiseMax(p1).cwiseMax(p1 + behind);
+    Add(HorizontalRect(NextId(), lo.x(), hi.x(), lo.y(), hi.y(), door_h,
+                       false, ppm_),
+        trim);
+  }
+  // A vertical rectangle between floor points p and q whose normal points
+  // along `facing`.
+  TexturedPlane VerticalRectFacing(const Vector2d& p, const Vector2d& q,
+                                   const Vector2d& facing, double h) const {
+    TexturedPlane r = VerticalRect(NextId(), p, q, 0.0, h, ppm_);
+    if (r.plane.normal.head<2>().dot(facing) < 0) {
+      r = VerticalRect(NextId(), q, p, 0.0, h, ppm_);
+    }
+    return r;
+  }
+  static void SetPolygonXy(TexturedPlane* plane,
+                           const std::vector<Vector2d>& polygon_xy) {
+    plane->polygon.clear();
+    for (const Vector2d& xy : polygon_xy) {
+      plane->polygon.push_back(
+          plane->frame.ToPlane(Vector3d(xy.x(), xy.y(), plane->frame.origin.z())));
+    }
+    // Counter-clockwise in the plane's (s, t), whichever way it faces.
+    if (PolygonArea(plane->polygon) < 0) {
+      std::reverse(plane->polygon.begin(), plane->polygon.end());
+    }
+  }
   void Add(TexturedPlane plane, Job job) {
     world_.planes.push_back(std::move(plane));
     jobs_.push_back(std::move(job));
@@ -554,6 +675,46 @@ void BuildRoom(World* w, uint64_t seed, double ppm) {
   w->path_closed = true;
 }
 
+// An L-shaped office corridor, 2 m wide and 2.5 m high: 10 m along x, then
+// a left turn into 6 m along y. Painted walls with plain stretches, a few
+// posters and skirting boards; doors recessed 5 cm with jambs and soffits,
+// placed by the seed. The robot drives down the middle and round the
+// corner, so the long side walls are seen at grazing angles throughout.
+void BuildOffice(World* w, uint64_t seed, double ppm) {
+  const double h = 2.5, door_w = 0.9, door_h = 2.05, depth = 0.05;
+  w->lights = {{1.25, 0, h}, {3.75, 0, h}, {6.25, 0, h},
+               {9.0, 0, h},  {9.0, 2.5, h}, {9.0, 5.0, h}};
+  cv::RNG rng(SimMixSeed(seed, 0xd00f));
+  // Door positions (s from the wall's end point b), clear of the corners.
+  auto doors = [&](int count, double len) {
+    std::vector<std::pair<double, double>> used;
+    std::vector<double> s =
+        PlaceIntervals(rng, count, door_w, 0.6, len - 0.6, 0.8, &used);
+    std::sort(s.begin(), s.end());
+    return s;
+  };
+  WorldBuilder b(w, seed, ppm);
+  // The boundary counter-clockwise, so the corridor is left of each wall.
+  b.WallWithDoors({0, -1}, {10, -1}, h, doors(2, 10.0), 3, door_w, door_h,
+                  depth);
+  b.WallWithDoors({10, -1}, {10, 7}, h, doors(2, 8.0), 2, door_w, door_h,
+                  depth);
+  b.Wall({10, 7}, {8, 7}, h, {0, 1, {}});
+  b.WallWithDoors({8, 7}, {8, 1}, h, doors(1, 6.0), 1, door_w, door_h,
+                  depth);
+  b.WallWithDoors({8, 1}, {0, 1}, h, doors(2, 8.0), 2, door_w, door_h,
+                  depth);
+  b.Wall({0, 1}, {0, -1}, h, {0, 1, {}});
+  const std::vector<Vector2d> outline = {{0, -1}, {10, -1}, {10, 7},
+                                         {8, 7},  {8, 1},   {0, 1}};
+  b.FloorPolygon(0, 10, -1, 7, outline);
+  b.CeilingPolygon(0, 10, -1, 7, h, outline);
+  b.Finish();
+  w->path_keypoints = {{0.8, 0.0}, {3.0, 0.1}, {5.5, -0.1}, {7.6, 0.0},
+                       {8.7, 0.5}, {9.0, 1.8}, {9.0, 4.0},  {9.0, 6.2}};
+  w->path_closed = false;
+}
+
 }  // namespace
 
 uint64_t SimMixSeed(uint64_t a, uint64_t b) {
@@ -571,7 +732,9 @@ size_t World::TextureBytes() const {
   return bytes;
 }
 
-std::vector<std::string> WorldNames() { return {"hallway", "lab-corner", "room"}; }
+std::vector<std::string> WorldNames() {
+  return {"hallway", "lab-corner", "room", "office"};
+}
 
 TexturedPlane MakeRectanglePlane(int id, const Vector3d& origin,
                                  const Vector3d& u_axis, const Vector3d& v_axis,
@@ -605,6 +768,8 @@ World MakeWorld(const std::string& name, uint64_t seed,
     BuildLabCorner(&w, seed, pixels_per_meter);
   } else if (name == "room") {
     BuildRoom(&w, seed, pixels_per_meter);
+  } else if (name == "office") {
+    BuildOffice(&w, seed, pixels_per_meter);
   } else {
     std::string valid;
     for (const std::string& n : WorldNames()) {

@@ -34,7 +34,7 @@ struct World {
   size_t TextureBytes() const;
 };
 
-// Names MakeWorld accepts: "hallway", "lab-corner", "room".
+// Names MakeWorld accepts: "hallway", "lab-corner", "room", "office".
 std::vector<std::string> WorldNames();
 
 // Texture resolution MakeWorld uses unless told otherwise (texels/m).

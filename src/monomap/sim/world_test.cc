@@ -33,7 +33,8 @@ TEST(WorldTest, EveryWorldHasValidPlanesAndTextures) {
       PolygonBounds(p.polygon, &lo, &hi);
       EXPECT_GE(p.texture.cols, hi.x() * p.pixels_per_meter - 1e-6);
       EXPECT_GE(p.texture.rows, hi.y() * p.pixels_per_meter - 1e-6);
-      EXPECT_GT(PolygonArea(p.polygon), 0.1);
+      // Not degenerate (the smallest: a door's 0.9 x 0.05 m soffit).
+      EXPECT_GT(PolygonArea(p.polygon), 0.04);
       std::vector<cv::Mat> ch;
       cv::split(p.texture, ch);
       double amin = 0;
@@ -46,6 +47,37 @@ TEST(WorldTest, EveryWorldHasValidPlanesAndTextures) {
       EXPECT_GT(stddev[0], 2.0) << "plane " << i << " is uniform";
     }
   }
+}
+
+TEST(WorldTest, OfficeDoorsAreRecessedBehindTheirWallsOpenings) {
+  const World w = MakeWorld("office", 2, 40.0);
+  // Each door leaf is parallel to a wall, 5 cm behind it (away from the
+  // corridor), and the wall's polygon leaves its opening out.
+  int leaves = 0;
+  for (const TexturedPlane& leaf : w.planes) {
+    if (std::abs(leaf.plane.normal.z()) > 1e-9) continue;
+    const double area = PolygonArea(leaf.polygon);
+    if (std::abs(area - 0.9 * 2.05) > 1e-9) continue;
+    const Eigen::Vector3d centre = leaf.frame.ToWorld({0.45, 1.0});
+    for (const TexturedPlane& wall : w.planes) {
+      if (wall.plane.normal.dot(leaf.plane.normal) < 1 - 1e-9) continue;
+      const double d = wall.plane.SignedDistance(centre);
+      if (std::abs(d + 0.05) > 1e-9) continue;
+      ++leaves;
+      // The opening in front of the leaf is not part of the wall.
+      EXPECT_FALSE(PointInPolygon(
+          wall.polygon, wall.frame.ToPlane(centre + 0.05 * leaf.plane.normal)));
+      // Above the opening it is.
+      EXPECT_TRUE(PointInPolygon(
+          wall.polygon,
+          wall.frame.ToPlane(centre + 0.05 * leaf.plane.normal +
+                             Eigen::Vector3d(0, 0, 1.3))));
+    }
+  }
+  EXPECT_EQ(leaves, 7);
+  // One floor plane for the whole L (its polygon is the L, 32 m^2).
+  EXPECT_NEAR(PolygonArea(w.planes[w.floor_plane].polygon), 2 * 10 + 2 * 6,
+              1e-9);
 }
 
 TEST(WorldTest, HallwayHasHighAndLowTextureRegions) {
