@@ -376,33 +376,83 @@ void MarkOutputDirectory(const fs::path& path, const std::string& kind) {
   WriteFileAtomic(path / kOutputMarkerFile, "monomap-output " + kind + "\n");
 }
 
+namespace {
+
+// Temporary files of WriteFileAtomic are "<name>.tmp-<pid>-<hex>": the pid
+// tells a leftover of a killed run from a file another run is writing.
+fs::path FileTemporary(const fs::path& path) {
+  return path.string() + ".tmp-" + std::to_string(::getpid()) + "-" +
+         RandomSuffix();
+}
+
+// Removes the temporaries of `path` whose writer no longer runs (killed
+// with SIGKILL, or the machine stopped).
+void RemoveStaleFileTemporaries(const fs::path& path) {
+  const fs::path parent =
+      path.parent_path().empty() ? fs::path(".") : path.parent_path();
+  const std::string prefix = path.filename().string() + ".tmp-";
+  std::error_code ec;
+  for (fs::directory_iterator it(parent, ec), end; !ec && it != end;
+       it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name.rfind(prefix, 0) != 0) continue;
+    const std::string rest = name.substr(prefix.size());
+    const size_t dash = rest.find('-');
+    if (dash == std::string::npos || !IsHex(rest.substr(dash + 1)) ||
+        rest.find_first_not_of("0123456789") != dash) {
+      continue;
+    }
+    const pid_t pid = static_cast<pid_t>(std::stol(rest.substr(0, dash)));
+    if (::kill(pid, 0) == 0 || errno != ESRCH) continue;  // still running
+    std::error_code ignored;
+    if (it->is_regular_file(ignored)) fs::remove(it->path(), ignored);
+  }
+}
+
+}  // namespace
+
 void WriteFileAtomic(const fs::path& path, const std::string& contents) {
   struct stat st {};
   if (::stat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode)) {
     throw OptionsError(path.string() + ": exists and is " +
                        FileTypeName(st.st_mode) + "; refusing to replace it");
   }
-  const fs::path temp = path.string() + ".tmp-" + RandomSuffix();
+  RemoveStaleFileTemporaries(path);
+  const fs::path temp = FileTemporary(path);
+  Registry& r = GetRegistry();
+  {
+    // Registered so that SIGINT/SIGTERM remove it too.
+    std::lock_guard<std::mutex> guard(r.mutex);
+    if (r.interrupted) throw OutputError(path.string() + ": interrupted");
+    r.temporaries.insert(temp);
+  }
+  auto unregister = [&r, &temp] {
+    std::lock_guard<std::mutex> guard(r.mutex);
+    r.temporaries.erase(temp);
+  };
+  std::error_code ec;
   {
     std::ofstream out(temp, std::ios::binary);
-    // Named by the path the user gave: the temporary name means nothing
-    // to them.
-    if (!out) throw OutputError(path.string() + ": cannot open for writing");
     out.write(contents.data(), static_cast<std::streamsize>(contents.size()));
     out.flush();
+    // Named by the path the user gave: the temporary name means nothing
+    // to them.
     if (!out) {
-      std::error_code ignored;
-      fs::remove(temp, ignored);
-      throw OutputError(path.string() + ": write failed");
+      fs::remove(temp, ec);
+      unregister();
+      throw OutputError(path.string() + (out.is_open() ? ": write failed"
+                                                      : ": cannot open for "
+                                                        "writing"));
     }
   }
-  std::error_code ec;
   fs::rename(temp, path, ec);
   if (ec) {
     std::error_code ignored;  // keep the rename's error for the message
     fs::remove(temp, ignored);
+    unregister();
     throw OutputError(path.string() + ": rename failed: " + ec.message());
   }
+  unregister();
 }
 
 AtomicDirectory::AtomicDirectory(fs::path final_path, std::string kind)

@@ -43,7 +43,10 @@ void CheckRegularFile(const std::filesystem::path& path);
 
 // Writes `contents` to `path` through a temporary file in the same folder
 // and a rename, so readers see the old file or the new one, never a part.
-// Throws OptionsError if `path` exists and is not a regular file.
+// The temporary (<name>.tmp-<pid>-<hex>) is removed on SIGINT/SIGTERM
+// like AtomicDirectory's; those of runs that were killed are removed by
+// the next write to the same path. Throws OptionsError if `path` exists
+// and is not a regular file, OutputError once interrupted.
 void WriteFileAtomic(const std::filesystem::path& path,
                      const std::string& contents);
 

@@ -216,6 +216,54 @@ TEST(File, InterruptRemovesTemporariesAndStopsCommits) {
   EXPECT_TRUE(fs::is_empty(dir));
 }
 
+TEST(File, WriteFileAtomicRemovesTemporariesOfKilledRuns) {
+  const fs::path dir = TempDir("file_leftovers");
+  // A writer killed with SIGKILL: a child that exits at once, so its pid
+  // is free (not running) afterwards.
+  const pid_t dead = fork();
+  ASSERT_GE(dead, 0);
+  if (dead == 0) _exit(0);
+  int status = 0;
+  ASSERT_EQ(waitpid(dead, &status, 0), dead);
+  const fs::path stale =
+      dir / ("report.json.tmp-" + std::to_string(dead) + "-1a2b");
+  // A writer that still runs (this process) and an unrelated file.
+  const fs::path live =
+      dir / ("report.json.tmp-" + std::to_string(getpid()) + "-3c4d");
+  const fs::path other = dir / "report.json.tmp-notes";
+  for (const fs::path& p : {stale, live, other}) std::ofstream(p) << "x";
+  WriteFileAtomic(dir / "report.json", "{}\n");
+  EXPECT_FALSE(fs::exists(stale));
+  EXPECT_TRUE(fs::exists(live));
+  EXPECT_TRUE(fs::exists(other));
+  EXPECT_EQ(ReadFileToString(dir / "report.json", 100), "{}\n");
+  // Nothing of its own is left behind: live, other and report.json.
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator()),
+            3);
+}
+
+TEST(File, WriteFileAtomicStopsWhenInterrupted) {
+  // In a child: the registry's interrupted state is process-wide.
+  const fs::path dir = TempDir("file_interrupt");
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    RemoveRegisteredTemporaries();
+    int code = 0;
+    try {
+      WriteFileAtomic(dir / "a.txt", "x");
+      code = 10;
+    } catch (const OutputError&) {
+    }
+    _exit(code);
+  }
+  int status = 0;
+  ASSERT_EQ(waitpid(pid, &status, 0), pid);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 0);
+  EXPECT_TRUE(fs::is_empty(dir));
+}
+
 TEST(File, ReadersRefuseWhatIsNotARegularFile) {
   const fs::path dir = TempDir("special");
   ASSERT_EQ(mkfifo((dir / "fifo").c_str(), 0600), 0);
