@@ -108,8 +108,11 @@ CheckerboardSpec ReadCheckerboardYaml(const std::filesystem::path& path) {
     throw InputError(path.string(), e.mark.line + 1,
                      "malformed YAML: " + e.msg);
   }
-  const YAML::Node b = root["chessboard"];
-  if (!b) throw InputError(path.string(), "chessboard", "missing");
+  // Subscripting a scalar or a list throws; check the kinds first.
+  const YAML::Node b = root.IsMap() ? root["chessboard"] : YAML::Node();
+  if (!b || !b.IsMap()) {
+    throw InputError(path.string(), "chessboard", "missing or not a map");
+  }
   CheckerboardSpec spec;
   try {
     spec.inner_corners_x = b["inner_corners_x"].as<int>();

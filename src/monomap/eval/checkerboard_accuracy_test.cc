@@ -2,7 +2,13 @@
 
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
 #include <opencv2/imgproc.hpp>
+
+#include "monomap/util/error.h"
 
 namespace monomap {
 namespace {
@@ -90,6 +96,28 @@ TEST(Checkerboard, NotFoundInPlainTexture) {
   p.texture.setTo(cv::Scalar(128, 128, 128, 255));
   map.planes.push_back(p);
   EXPECT_FALSE(EvaluateCheckerboard(map, CheckerboardSpec{}).found);
+}
+
+TEST(Checkerboard, YamlOfTheWrongKindNamesTheField) {
+  // Each was an unwrapped yaml-cpp error (an internal error) before.
+  const std::filesystem::path path =
+      std::filesystem::temp_directory_path() /
+      ("monomap_checkerboard_" + std::to_string(::getpid()) + ".yaml");
+  for (const std::string text :
+       {"just a scalar\n", "- a\n- list\n", "chessboard: 3\n",
+        "chessboard: [1, 2]\n", "chessboard:\n  inner_corners_x: [1]\n"}) {
+    std::ofstream(path) << text;
+    try {
+      ReadCheckerboardYaml(path);
+      ADD_FAILURE() << "accepted: " << text;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("chessboard"), std::string::npos)
+          << e.what();
+      EXPECT_NE(std::string(e.what()).find(path.string()), std::string::npos)
+          << e.what();
+    }
+  }
+  std::filesystem::remove(path);
 }
 
 }  // namespace
