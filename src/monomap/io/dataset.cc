@@ -378,11 +378,11 @@ DatasetFrame MakeFrame(const fs::path& root, const RgbEntry& rgb,
   f.image_path = fs::absolute(rgb.path);
   if (!InterpolatePose(odometry.world_from_cam, f.timestamp,
                        options.max_odometry_gap, &f.odometry_world_from_cam)) {
-    throw InputError((root / "rgb.txt").string(), rgb.line,
-                     "no odometry for frame at t=" +
-                         std::to_string(f.timestamp) +
-                         " (outside the odometry or in a gap larger than " +
-                         std::to_string(options.max_odometry_gap) + " s)");
+    throw InputError(
+        (root / "rgb.txt").string(), rgb.line,
+        "no odometry for frame at t=" + std::to_string(f.timestamp) +
+            " (outside the odometry or in a gap larger than " +
+            std::to_string(options.max_odometry_gap) + " s)");
   }
   if (!odometry.planar.empty()) {
     f.odometry_base = InterpolatePose2d(odometry.planar, f.timestamp);

@@ -255,11 +255,11 @@ void GlbBuilder::AddTexturedPlane(const TexturedPlane& plane,
       AddFloatAccessor(normals.data(), n, TINYGLTF_TYPE_VEC3, 3);
   primitive.attributes["TEXCOORD_0"] =
       AddFloatAccessor(texcoords.data(), n, TINYGLTF_TYPE_VEC2, 2);
-  primitive.indices = AddAccessor(
-      AddView(indices.data(), indices.size() * sizeof(uint32_t),
-              TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER),
-      TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR,
-      indices.size());
+  primitive.indices =
+      AddAccessor(AddView(indices.data(), indices.size() * sizeof(uint32_t),
+                          TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER),
+                  TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR,
+                  indices.size());
   primitive.material = AddTextureMaterial(plane, name, path);
   AddMeshNode(name, primitive);
 }

@@ -128,10 +128,12 @@ void ExpectPlaneGeometry(const tinygltf::Model& model,
   double max_position_error = 0, max_uv_error = 0;
   for (size_t k = 0; k < n; ++k) {
     const Eigen::Vector3d x = plane.frame.ToWorld(plane.polygon[k]);
-    max_position_error = std::max(
-        max_position_error,
-        (Eigen::Vector3d(positions[3 * k], positions[3 * k + 1],
-                         positions[3 * k + 2]) - x).norm());
+    max_position_error =
+        std::max(max_position_error,
+                 (Eigen::Vector3d(positions[3 * k], positions[3 * k + 1],
+                                  positions[3 * k + 2]) -
+                  x)
+                     .norm());
     EXPECT_LT(std::abs(plane.plane.SignedDistance(x)), 1e-12);
     // The texel centre convention: pixel (c, r) centre at uv
     // ((c + 0.5) / width, (r + 0.5) / height).
@@ -227,18 +229,17 @@ double MaxPointError(const std::vector<float>& xyz,
                      const std::vector<Eigen::Vector3d>& expected) {
   double max_error = 0;
   for (size_t i = 0; i < expected.size(); ++i) {
-    max_error = std::max(
-        max_error,
-        (Eigen::Vector3d(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]) -
-         expected[i])
-            .norm());
+    max_error =
+        std::max(max_error,
+                 (Eigen::Vector3d(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]) -
+                  expected[i])
+                     .norm());
   }
   return max_error;
 }
 
 // Node "camera_path": a LINE_STRIP through the trajectory's centres.
-void ExpectCameraPath(const tinygltf::Model& model, const Map& map,
-                      bool y_up) {
+void ExpectCameraPath(const tinygltf::Model& model, const Map& map, bool y_up) {
   const tinygltf::Node* path_node = FindNode(model, "camera_path");
   ASSERT_NE(path_node, nullptr);
   const tinygltf::Primitive& line =

@@ -186,8 +186,7 @@ void ReadPlaneFrame(const JsonFields& f, const json& p,
   const struct {
     const char* key;
     const Eigen::Vector3d& axis;
-  } axes[] = {{"u_axis", plane->frame.u_axis},
-              {"v_axis", plane->frame.v_axis}};
+  } axes[] = {{"u_axis", plane->frame.u_axis}, {"v_axis", plane->frame.v_axis}};
   for (const auto& a : axes) {
     const std::string axis_field = JsonFields::Join(field, a.key);
     if (std::abs(a.axis.norm() - 1.0) > kMapUnitTolerance) {
@@ -227,8 +226,7 @@ Polygon2d ReadPolygon(const JsonFields& f, const json& p,
   return vertices;
 }
 
-std::vector<PlaneFeature> ReadPlaneFeatures(const JsonFields& f,
-                                            const json& p,
+std::vector<PlaneFeature> ReadPlaneFeatures(const JsonFields& f, const json& p,
                                             const std::string& field) {
   const std::string features_field = JsonFields::Join(field, "features");
   const json& features = f.Array(p, field, "features");

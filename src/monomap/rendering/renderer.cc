@@ -339,8 +339,8 @@ bool ProjectPlane(const PlaneFrame& frame, double ppm,
 
 // Extent [lo, hi] of the polygon within the band of rows [v - 1, v + 1];
 // lo > hi if the band misses it.
-void PolygonRowExtent(const std::array<Eigen::Vector2d, 8>& poly, int n,
-                      int v, double* lo_out, double* hi_out) {
+void PolygonRowExtent(const std::array<Eigen::Vector2d, 8>& poly, int n, int v,
+                      double* lo_out, double* hi_out) {
   const double b0 = v - 1.0, b1 = v + 1.0;
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
   for (int i = 0; i < n; ++i) {
@@ -378,10 +378,9 @@ int MipLevel(const Eigen::Matrix3d& texel_from_pixel, int s0, int s1, int v,
   const double dydu = (hd(1, 0) - y * hd(2, 0)) / t.z();
   const double dxdv = (hd(0, 1) - x * hd(2, 1)) / t.z();
   const double dydv = (hd(1, 1) - y * hd(2, 1)) / t.z();
-  const double rho2 = area_footprint
-                          ? std::abs(dxdu * dydv - dydu * dxdv)
-                          : std::max(dxdu * dxdu + dydu * dydu,
-                                     dxdv * dxdv + dydv * dydv);
+  const double rho2 = area_footprint ? std::abs(dxdu * dydv - dydu * dxdv)
+                                     : std::max(dxdu * dxdu + dydu * dydu,
+                                                dxdv * dxdv + dydv * dydv);
   const double lambda = 0.5 * std::log2(rho2) + bias;
   if (!(lambda > 0.5)) return 0;
   return std::min(num_levels - 1, static_cast<int>(std::floor(lambda + 0.5)));
@@ -531,8 +530,8 @@ std::vector<Renderer::PlaneView> Renderer::ViewPlanes(
 
 template <int C>
 RenderStats Renderer::RenderImpl(const Camera& camera,
-                                 const Rigid3d& world_from_cam,
-                                 cv::Mat* image, cv::Mat* depth) const {
+                                 const Rigid3d& world_from_cam, cv::Mat* image,
+                                 cv::Mat* depth) const {
   CheckOption(camera.width > 0 && camera.height > 0 && camera.fx > 0 &&
                   camera.fy > 0,
               "camera", "needs a positive size and focal lengths");

@@ -173,8 +173,8 @@ struct HomographyContext {
 };
 
 // Samples of the plane (plane coordinates) that project into the image.
-int VisibleSamples(const HomographyContext& ctx,
-                   const Rigid3d& cam_from_world, const PlaneFrame& frame,
+int VisibleSamples(const HomographyContext& ctx, const Rigid3d& cam_from_world,
+                   const PlaneFrame& frame,
                    const std::vector<Eigen::Vector2d>& samples) {
   int visible = 0;
   for (const auto& st : samples) {
@@ -193,8 +193,7 @@ int VisibleSamples(const HomographyContext& ctx,
 bool CorrectedHomography(const Eigen::Matrix3d& pixel_from_plane,
                          const std::vector<FeatureSighting>& feats,
                          const Eigen::Vector2d& centre,
-                         const HomographyOptions& options,
-                         Eigen::Matrix3d* h) {
+                         const HomographyOptions& options, Eigen::Matrix3d* h) {
   std::vector<cv::Point2f> predicted, observed;
   for (const auto& s : feats) {
     const Eigen::Vector3d y = pixel_from_plane * s.st.homogeneous();
@@ -294,8 +293,7 @@ bool FramePlaneHomography(const HomographyContext& ctx, int f,
 void CollectHomographies(
     const std::vector<std::vector<ImagePlaneHomography>>& per_frame,
     const std::vector<int>& attempted,
-    std::vector<ImagePlaneHomography>* homographies,
-    HomographyReport* report) {
+    std::vector<ImagePlaneHomography>* homographies, HomographyReport* report) {
   std::vector<double> before, after;
   for (size_t f = 0; f < per_frame.size(); ++f) {
     for (const auto& hp : per_frame[f]) {

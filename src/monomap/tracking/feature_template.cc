@@ -131,8 +131,7 @@ namespace {
 // mean and variance. The warp must lie where Sample() may read.
 void SampleWarpedPatch(const cv::Mat& grey, const Eigen::Matrix2f& a,
                        const Eigen::Vector2f& t, int r,
-                       std::vector<float>* samples, double* mean,
-                       double* var) {
+                       std::vector<float>* samples, double* mean, double* var) {
   double sum = 0.0, sum2 = 0.0;
   size_t k = 0;
   for (int y = -r; y <= r; ++y) {
@@ -172,8 +171,8 @@ double TemplateResidual(const std::vector<float>& samples, double mean,
 
 // Inverse compositional update of the warp (A, t): W <- W o W(dp)^-1.
 // False if W(dp) is (nearly) singular.
-bool ComposeInverse(const Eigen::Matrix<double, 6, 1>& dp,
-                    Eigen::Matrix2f* a, Eigen::Vector2f* t) {
+bool ComposeInverse(const Eigen::Matrix<double, 6, 1>& dp, Eigen::Matrix2f* a,
+                    Eigen::Vector2f* t) {
   Eigen::Matrix2d d;
   d << 1.0 + dp(0), dp(1), dp(2), 1.0 + dp(3);
   if (std::abs(d.determinant()) < 1e-6) return false;

@@ -176,12 +176,10 @@ class KltTracker {
   void KeepTracked(const std::vector<size_t>& forward_ok,
                    const std::vector<cv::Point2f>& fwd_pts,
                    const std::vector<cv::Point2f>& back_pts,
-                   const std::vector<uchar>& back_status,
-                   KltFrameStats* stats);
+                   const std::vector<uchar>& back_status, KltFrameStats* stats);
   // Affine refinement of the features due this frame; spreads each
   // correction over the observations since their last alignment.
-  void RefineActive(int frame_index, const cv::Mat& grey,
-                    KltFrameStats* stats);
+  void RefineActive(int frame_index, const cv::Mat& grey, KltFrameStats* stats);
   void Detect(int frame_index, const cv::Mat& grey, KltFrameStats* stats);
   // Detection grid cell of a pixel.
   int CellOf(const cv::Point2f& p) const;
