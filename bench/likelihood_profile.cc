@@ -23,16 +23,12 @@
 #include "monomap/io/map_format.h"
 #include "monomap/localization/measurement_model.h"
 #include "monomap/rendering/renderer.h"
+#include "monomap/util/angles.h"
+#include "monomap/util/stats.h"
 #include "sweep_main.h"
 
 namespace monomap {
 namespace {
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return NAN;
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
-}
 
 struct Axis {
   const char* name;
@@ -55,7 +51,7 @@ Rigid3d MoveCamZ(const Rigid3d& p, double a) {
 Rigid3d Yaw(const Rigid3d& p, double deg) {
   Rigid3d out = p;
   out.rotation = Eigen::Quaterniond(Eigen::AngleAxisd(
-                     deg * M_PI / 180.0, Eigen::Vector3d::UnitZ())) *
+                     DegToRadMulDiv(deg), Eigen::Vector3d::UnitZ())) *
                  p.rotation;
   return out;
 }
@@ -104,8 +100,8 @@ int Run(const ProfileOptions& o) {
     std::vector<double> abs_peaks;
     for (double p : peaks) abs_peaks.push_back(std::abs(p));
     std::printf("%s (%d frames): peak median %+.3f %s, median |peak| %.3f %s\n",
-                axis.name, frames, Median(peaks), axis.unit, Median(abs_peaks),
-                axis.unit);
+                axis.name, frames, UpperMedian(peaks), axis.unit,
+                UpperMedian(abs_peaks), axis.unit);
     for (int k = 0; k < n; ++k) {
       std::printf("  %+7.3f %s  mean dlogL %+8.3f\n",
                   (k - o.samples) * axis.step, axis.unit, sum[k] / frames);

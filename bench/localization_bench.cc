@@ -1,5 +1,5 @@
 // One update of the localization filter on the synthetic room of
-// localization/test_scene.h (floor + 4 walls, 320x240 live camera with
+// sim/room_scene.h (floor + 4 walls, 320x240 live camera with
 // distortion): predict + render (80x60) + weigh + resample for MCL with a
 // fixed count of 1000 particles, and the same plus Monte Carlo Correction
 // of the 8 heaviest particles (160x120 renders, KLT, PnP) and merging for
@@ -11,19 +11,19 @@
 #include <benchmark/benchmark.h>
 
 #include "monomap/localization/localizer.h"
-#include "monomap/localization/test_scene.h"
+#include "monomap/sim/room_scene.h"
 
 namespace monomap {
 namespace {
 
 struct Scene {
-  Map map = test_scene::RoomMap();
-  Camera camera = test_scene::LiveCamera();
-  Rigid3d mount = test_scene::BaseFromCam();
+  Map map = testing::RoomMap();
+  Camera camera = testing::LiveCamera();
+  Rigid3d mount = testing::BaseFromCam();
   Renderer renderer{map};
   Pose2d base{0.5, 0.2, 0.4};
   Rigid3d truth = WorldFromCamOfBase(base, mount);
-  cv::Mat live = test_scene::LiveImage(renderer, camera, truth, 0.8, 15, 2.0, 1);
+  cv::Mat live = testing::LiveImage(renderer, camera, truth, 0.8, 15, 2.0, 1);
 };
 
 const Scene& GetScene() {

@@ -41,10 +41,12 @@
 #include "monomap/pipelines/localization_pipeline.h"
 #include "monomap/pipelines/mapping_pipeline.h"
 #include "monomap/sim/simulate.h"
+#include "monomap/util/angles.h"
 #include "monomap/util/error.h"
 #include "monomap/util/file.h"
 #include "monomap/util/progress.h"
 #include "monomap/util/runtime.h"
+#include "monomap/util/stats.h"
 #include "sweep_main.h"
 
 namespace monomap {
@@ -119,14 +121,12 @@ struct ConfigRun {
   std::vector<int> particles;  // per step, after the update
 };
 
-double Median(std::vector<double> v) {
-  v.erase(std::remove_if(v.begin(), v.end(),
-                         [](double x) { return !std::isfinite(x); }),
-          v.end());
+// Median of the finite values (failed runs report NaN errors); NaN if
+// there are none, so that "no value" does not read as 0.
+double FiniteMedian(std::vector<double> v) {
+  std::erase_if(v, [](double x) { return !std::isfinite(x); });
   if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+  return Median(std::move(v));
 }
 
 double Mean(const std::vector<double>& v) {
@@ -275,7 +275,7 @@ nlohmann::json RunSeed(const SweepOptions& o, const std::string& world,
                    {"skip", o.kidnap_skip},
                    {"distance_m", (to.translation - from.translation).norm()},
                    {"rotation_deg",
-                    AngleBetween(from.rotation, to.rotation) * 180.0 / M_PI}};
+                    RadToDegMulDiv(AngleBetween(from.rotation, to.rotation))}};
   }
   j["localization_run"] = {{"frames", live.frames.size()},
                            {"run_seed", sim.run_seed},
@@ -365,7 +365,7 @@ nlohmann::json RunSeed(const SweepOptions& o, const std::string& world,
       return nlohmann::json::array(
           {std::round(1e4 * p.translation.x()) / 1e4,
            std::round(1e4 * p.translation.y()) / 1e4,
-           std::round(1e2 * std::atan2(z.y(), z.x()) * 180.0 / M_PI) / 1e2});
+           std::round(RadToDegMulDiv(1e2 * std::atan2(z.y(), z.x()))) / 1e2});
     };
     for (size_t k = 0; k < trajectory.size() && k < live_truth.size(); ++k) {
       est_xy.push_back(planar(trajectory[k].world_from_cam));
@@ -470,11 +470,11 @@ nlohmann::json Summarize(const SweepOptions& o, const std::string& world,
     s["successes"] = success;
     if (o.kidnap_after > 0) s["tracked_before_kidnap"] = tracked;
     s["success_rate"] = n > 0 ? static_cast<double>(success) / n : 0.0;
-    s["median_converged_step"] = Number(Median(conv));
-    s["median_final_translation_error_m"] = Number(Median(final_t));
-    s["median_final_rotation_error_deg"] = Number(Median(final_r));
-    s["median_mean_translation_error_m"] = Number(Median(mean_t));
-    s["median_mean_rotation_error_deg"] = Number(Median(mean_r));
+    s["median_converged_step"] = Number(FiniteMedian(conv));
+    s["median_final_translation_error_m"] = Number(FiniteMedian(final_t));
+    s["median_final_rotation_error_deg"] = Number(FiniteMedian(final_r));
+    s["median_mean_translation_error_m"] = Number(FiniteMedian(mean_t));
+    s["median_mean_rotation_error_deg"] = Number(FiniteMedian(mean_r));
     s["mean_particles"] = Number(Mean(particles));
     s["mean_ms_per_update"] = Number(Mean(ms));
     nlohmann::json pt = nlohmann::json::object();
@@ -496,11 +496,11 @@ nlohmann::json Summarize(const SweepOptions& o, const std::string& world,
         o.kidnap_after > 0
             ? (" (tracking before: " + std::to_string(tracked) + ")").c_str()
             : "",
-        Fmt("%.0f", Median(conv)).c_str(),
-        Fmt("%.1f", 100 * Median(final_t)).c_str(),
-        Fmt("%.1f", Median(final_r)).c_str(),
-        Fmt("%.1f", 100 * Median(mean_t)).c_str(),
-        Fmt("%.2f", Median(mean_r)).c_str(),
+        Fmt("%.0f", FiniteMedian(conv)).c_str(),
+        Fmt("%.1f", 100 * FiniteMedian(final_t)).c_str(),
+        Fmt("%.1f", FiniteMedian(final_r)).c_str(),
+        Fmt("%.1f", 100 * FiniteMedian(mean_t)).c_str(),
+        Fmt("%.2f", FiniteMedian(mean_r)).c_str(),
         Fmt("%.0f", Mean(particles)).c_str(), Fmt("%.1f", Mean(ms)).c_str());
   }
   std::printf(

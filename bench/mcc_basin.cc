@@ -24,15 +24,11 @@
 #include "monomap/localization/mcc.h"
 #include "monomap/localization/measurement_model.h"
 #include "monomap/rendering/renderer.h"
+#include "monomap/util/angles.h"
+#include "monomap/util/stats.h"
 
 namespace monomap {
 namespace {
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
-}
 
 int Run(int argc, char** argv) {
   CLI::App app{"Basin of one Monte Carlo Correction"};
@@ -107,7 +103,7 @@ int Run(int argc, char** argv) {
       Rigid3d start = *gt;
       start.translation += gt->rotation * off.t_cam;
       start.rotation =
-          Eigen::Quaterniond(Eigen::AngleAxisd(off.yaw_deg * M_PI / 180.0,
+          Eigen::Quaterniond(Eigen::AngleAxisd(DegToRadMulDiv(off.yaw_deg),
                                                Eigen::Vector3d::UnitZ())) *
           start.rotation;
       const MccResult r = corrector.Correct(live, start);
@@ -128,9 +124,9 @@ int Run(int argc, char** argv) {
       after.push_back((r.world_from_cam.translation - gt->translation).norm());
     }
     std::printf("%-14s %7.0f%% %8.0f %8.0f %8.0f %9.1f cm %9.1f cm\n", off.name,
-                100.0 * accepted / std::max(1, tried), Median(corners),
-                Median(tracked), Median(inliers), 100 * Median(before),
-                100 * Median(after));
+                100.0 * accepted / std::max(1, tried), UpperMedian(corners),
+                UpperMedian(tracked), UpperMedian(inliers),
+                100 * UpperMedian(before), 100 * UpperMedian(after));
   }
   return 0;
 }

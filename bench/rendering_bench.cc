@@ -28,6 +28,7 @@
 
 #include "monomap/io/map_format.h"
 #include "monomap/rendering/renderer.h"
+#include "monomap/util/angles.h"
 #include "monomap/util/error.h"
 
 namespace monomap {
@@ -239,7 +240,7 @@ MapScene LoadMapScene(const std::string& dir) {
     const Vector3d axis =
         Vector3d(rng.gaussian(1), rng.gaussian(1), rng.gaussian(1))
             .normalized();
-    const double angle = rng.uniform(0.0, 2.0) * M_PI / 180.0;
+    const double angle = DegToRadMulDiv(rng.uniform(0.0, 2.0));
     scene.poses.emplace_back(
         at.rotation * Eigen::Quaterniond(Eigen::AngleAxisd(angle, axis)),
         at.translation + shift);

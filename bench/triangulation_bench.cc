@@ -12,6 +12,8 @@
 #include "monomap/triangulation/bundle_adjustment.h"
 #include "monomap/sim/synthetic_scene.h"
 #include "monomap/triangulation/triangulator.h"
+#include "monomap/util/angles.h"
+#include "monomap/util/stats.h"
 
 namespace monomap {
 namespace {
@@ -89,8 +91,7 @@ void BM_BundleAdjust(benchmark::State& state) {
       for (const Landmark& l : ls) {
         e.push_back((l.x_in_world - p.scene.points[l.id]).norm());
       }
-      std::nth_element(e.begin(), e.begin() + e.size() / 2, e.end());
-      return e[e.size() / 2];
+      return UpperMedian(std::move(e));
     };
     auto mean_rotation_error = [&](const std::vector<Rigid3d>& ps) {
       double sum = 0.0;
@@ -98,7 +99,7 @@ void BM_BundleAdjust(benchmark::State& state) {
         sum += AngleBetween(ps[i].rotation,
                             p.scene.world_from_cam[i].rotation);
       }
-      return sum / ps.size() * 180.0 / M_PI;
+      return RadToDegMulDiv(sum / ps.size());
     };
     state.counters["pt_err_mm_before"] = 1e3 * median_point_error(p.landmarks);
     state.counters["pt_err_mm_after"] = 1e3 * median_point_error(landmarks);

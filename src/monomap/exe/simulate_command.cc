@@ -13,22 +13,10 @@
 
 namespace monomap {
 
-void RegisterSimulateCommand(CLI::App& app) {
-  auto o = std::make_shared<SimulationOptions>();
-  auto out = std::make_shared<std::string>();
-  auto quiet = std::make_shared<bool>(false);
-  CLI::App* cmd = app.add_subcommand(
-      "simulate",
-      "Generate a synthetic dataset with exact ground truth (worlds: " +
-          [] {
-            std::string s;
-            for (const auto& n : WorldNames()) s += (s.empty() ? "" : ", ") + n;
-            return s;
-          }() +
-          ")");
-  cmd->add_option("world", o->world, "World name")->required();
-  cmd->add_option("-o,--output", *out, "Dataset directory to write")
-      ->required();
+namespace {
+
+// Seeds and where along the path the run goes.
+void AddRunOptions(CLI::App* cmd, SimulationOptions* o) {
   cmd->add_option("--seed", o->seed,
                   "Seed of the world (textures) and, without --run-seed, of "
                   "the run")
@@ -46,6 +34,10 @@ void RegisterSimulateCommand(CLI::App& app) {
   cmd->add_option("--frames", o->num_frames,
                   "Number of frames (-1: the whole path)")
       ->capture_default_str();
+}
+
+// The image, the camera and how it is mounted.
+void AddCameraOptions(CLI::App* cmd, SimulationOptions* o) {
   cmd->add_option("--width", o->width, "Image width")->capture_default_str();
   cmd->add_option("--height", o->height, "Image height")->capture_default_str();
   cmd->add_option("--speed", o->path.speed_mps, "Robot speed (m/s)")
@@ -65,6 +57,10 @@ void RegisterSimulateCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--k2", o->k2, "Radial distortion k2 (plumb_bob)")
       ->capture_default_str();
+}
+
+// The errors of the simulated wheel odometry.
+void AddOdometryOptions(CLI::App* cmd, SimulationOptions* o) {
   cmd->add_option("--odometry-scale-error", o->odometry.wheel_radius_error,
                   "Systematic wheel radius error (fraction)")
       ->capture_default_str();
@@ -81,6 +77,29 @@ void RegisterSimulateCommand(CLI::App& app) {
   cmd->add_option("--odometry-seed", o->odometry.seed,
                   "Seed of the odometry errors")
       ->capture_default_str();
+}
+
+}  // namespace
+
+void RegisterSimulateCommand(CLI::App& app) {
+  auto o = std::make_shared<SimulationOptions>();
+  auto out = std::make_shared<std::string>();
+  auto quiet = std::make_shared<bool>(false);
+  CLI::App* cmd = app.add_subcommand(
+      "simulate",
+      "Generate a synthetic dataset with exact ground truth (worlds: " +
+          [] {
+            std::string s;
+            for (const auto& n : WorldNames()) s += (s.empty() ? "" : ", ") + n;
+            return s;
+          }() +
+          ")");
+  cmd->add_option("world", o->world, "World name")->required();
+  cmd->add_option("-o,--output", *out, "Dataset directory to write")
+      ->required();
+  AddRunOptions(cmd, o.get());
+  AddCameraOptions(cmd, o.get());
+  AddOdometryOptions(cmd, o.get());
   cmd->add_flag("--moving-object", o->moving_object,
                 "Add an object crossing the view");
   cmd->add_flag("--highlight", o->specular_highlight,

@@ -296,24 +296,26 @@ void WriteCameraMountYaml(const fs::path& path, const Rigid3d& base_from_cam) {
   WriteFileAtomic(path, out.str());
 }
 
-Dataset LoadDataset(const fs::path& root, const DatasetOptions& options) {
-  options.Check();
-  std::error_code ec;
-  if (!fs::is_directory(root, ec)) {
-    throw InputError(root.string() + ": dataset directory not found");
-  }
-  Dataset ds;
-  ds.root = fs::absolute(root);
-  ds.camera = ReadCameraYaml(options.camera_yaml.empty() ? root / "camera.yaml"
-                                                         : options.camera_yaml);
-  const std::vector<RgbEntry> rgb = ReadRgbList(root);
+namespace {
 
+// A dataset's odometry: the camera's (6-DoF) and, from odometry2d.txt,
+// the base's planar poses.
+struct DatasetOdometry {
+  std::vector<TimedPose> world_from_cam;
+  std::vector<std::pair<double, Pose2d>> planar;
+};
+
+// Reads odometry2d.txt (with camera_mount.yaml, into ds->base_from_cam)
+// and odometry.txt, dropping implausible samples (counted in ds).
+DatasetOdometry ReadDatasetOdometry(const fs::path& root,
+                                    const DatasetOptions& options,
+                                    Dataset* ds) {
   const fs::path odom_path = root / "odometry.txt";
   const fs::path odom2d_path = root / "odometry2d.txt";
   std::vector<TimedPose> odometry;
   std::vector<std::pair<double, Pose2d>> odometry2d;
   if (PathExists(odom2d_path)) {
-    ds.base_from_cam = ReadCameraMountYaml(root / "camera_mount.yaml");
+    ds->base_from_cam = ReadCameraMountYaml(root / "camera_mount.yaml");
     std::vector<int> lines;
     odometry2d = ReadOdometry2d(odom2d_path, &lines);
     CheckOdometryPlausible(
@@ -322,9 +324,9 @@ Dataset LoadDataset(const fs::path& root, const DatasetOptions& options) {
           return Eigen::Vector3d(s.second.x, s.second.y, 0.0);
         },
         [](const auto& s) { return s.second.yaw; }, &odometry2d, lines,
-        &ds.dropped_odometry_lines);
+        &ds->dropped_odometry_lines);
     for (const auto& [t, p] : odometry2d) {
-      odometry.push_back({t, WorldFromCamOfBase(p, *ds.base_from_cam)});
+      odometry.push_back({t, WorldFromCamOfBase(p, *ds->base_from_cam)});
     }
   }
   // odometry.txt, when present, gives the full 6-DoF camera odometry and
@@ -336,12 +338,79 @@ Dataset LoadDataset(const fs::path& root, const DatasetOptions& options) {
         odom_path, options,
         [](const TimedPose& p) { return p.world_from_cam.translation; },
         [](const TimedPose&) { return 0.0; }, &odometry, lines,
-        &ds.dropped_odometry_lines);
+        &ds->dropped_odometry_lines);
   } else if (odometry.empty()) {
     throw InputError(root.string() +
                      ": no odometry (need odometry.txt, or odometry2d.txt "
                      "with camera_mount.yaml)");
   }
+  return {std::move(odometry), std::move(odometry2d)};
+}
+
+// The planar pose at time t, interpolated linearly (yaw unwrapped across
+// the pair); none after the last sample, the first sample before it.
+std::optional<Pose2d> InterpolatePose2d(
+    const std::vector<std::pair<double, Pose2d>>& odometry2d, double t) {
+  auto it = std::lower_bound(
+      odometry2d.begin(), odometry2d.end(), t - 1e-6,
+      [](const auto& p, double time) { return p.first < time; });
+  if (it == odometry2d.end()) return std::nullopt;
+  if (std::abs(it->first - t) <= 1e-6 || it == odometry2d.begin()) {
+    return it->second;
+  }
+  const auto& a = *std::prev(it);
+  const auto& b = *it;
+  const double s = (t - a.first) / (b.first - a.first);
+  const double dyaw = std::remainder(b.second.yaw - a.second.yaw, 2.0 * M_PI);
+  return Pose2d{a.second.x + s * (b.second.x - a.second.x),
+                a.second.y + s * (b.second.y - a.second.y),
+                a.second.yaw + s * dyaw};
+}
+
+// The frame of an rgb.txt entry with its odometry (and ground truth, if
+// any) at the image's time. Throws if odometry does not cover it.
+DatasetFrame MakeFrame(const fs::path& root, const RgbEntry& rgb,
+                       const DatasetOdometry& odometry,
+                       const std::vector<TimedPose>* groundtruth,
+                       const DatasetOptions& options) {
+  DatasetFrame f;
+  f.timestamp = rgb.timestamp;
+  f.image_path = fs::absolute(rgb.path);
+  if (!InterpolatePose(odometry.world_from_cam, f.timestamp,
+                       options.max_odometry_gap, &f.odometry_world_from_cam)) {
+    throw InputError(
+        (root / "rgb.txt").string(), rgb.line,
+        "no odometry for frame at t=" + std::to_string(f.timestamp) +
+            " (outside the odometry or in a gap larger than " +
+            std::to_string(options.max_odometry_gap) + " s)");
+  }
+  if (!odometry.planar.empty()) {
+    f.odometry_base = InterpolatePose2d(odometry.planar, f.timestamp);
+  }
+  if (groundtruth != nullptr) {
+    Rigid3d gt;
+    if (InterpolatePose(*groundtruth, f.timestamp, options.max_odometry_gap,
+                        &gt)) {
+      f.groundtruth_world_from_cam = gt;
+    }
+  }
+  return f;
+}
+
+}  // namespace
+
+Dataset LoadDataset(const fs::path& root, const DatasetOptions& options) {
+  options.Check();
+  std::error_code ec;
+  if (!fs::is_directory(root, ec)) {
+    throw InputError(root.string() + ": dataset directory not found");
+  }
+  Dataset ds;
+  ds.root = fs::absolute(root);
+  ds.camera = ReadCameraYaml(options.camera_yaml.empty() ? root / "camera.yaml"
+                                                         : options.camera_yaml);
+  const std::vector<RgbEntry> rgb = ReadRgbList(root);
+  const DatasetOdometry odometry = ReadDatasetOdometry(root, options, &ds);
   std::vector<TimedPose> groundtruth;
   const fs::path gt_path = root / "groundtruth.txt";
   if (options.load_groundtruth && PathExists(gt_path)) {
@@ -360,47 +429,9 @@ Dataset LoadDataset(const fs::path& root, const DatasetOptions& options) {
     last = std::min(last, first + static_cast<size_t>(options.num_frames));
   }
   for (size_t i = first; i < last; ++i) {
-    DatasetFrame f;
-    f.timestamp = rgb[i].timestamp;
-    f.image_path = fs::absolute(rgb[i].path);
-    if (!InterpolatePose(odometry, f.timestamp, options.max_odometry_gap,
-                         &f.odometry_world_from_cam)) {
-      throw InputError((root / "rgb.txt").string(), rgb[i].line,
-                       "no odometry for frame at t=" +
-                           std::to_string(f.timestamp) +
-                           " (outside the odometry or in a gap larger than " +
-                           std::to_string(options.max_odometry_gap) + " s)");
-    }
-    if (!odometry2d.empty()) {
-      // Interpolate the planar pose too (yaw unwrapped across the pair).
-      auto it = std::lower_bound(
-          odometry2d.begin(), odometry2d.end(), f.timestamp - 1e-6,
-          [](const auto& p, double t) { return p.first < t; });
-      if (it != odometry2d.end()) {
-        if (std::abs(it->first - f.timestamp) <= 1e-6 ||
-            it == odometry2d.begin()) {
-          f.odometry_base = it->second;
-        } else {
-          const auto& a = *std::prev(it);
-          const auto& b = *it;
-          const double s = (f.timestamp - a.first) / (b.first - a.first);
-          const double dyaw = std::remainder(b.second.yaw - a.second.yaw,
-                                             2.0 * M_PI);
-          f.odometry_base = Pose2d{
-              a.second.x + s * (b.second.x - a.second.x),
-              a.second.y + s * (b.second.y - a.second.y),
-              a.second.yaw + s * dyaw};
-        }
-      }
-    }
-    if (ds.has_groundtruth) {
-      Rigid3d gt;
-      if (InterpolatePose(groundtruth, f.timestamp, options.max_odometry_gap,
-                          &gt)) {
-        f.groundtruth_world_from_cam = gt;
-      }
-    }
-    ds.frames.push_back(f);
+    ds.frames.push_back(MakeFrame(root, rgb[i], odometry,
+                                  ds.has_groundtruth ? &groundtruth : nullptr,
+                                  options));
   }
   return ds;
 }

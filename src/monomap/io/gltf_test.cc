@@ -65,7 +65,9 @@ std::vector<T> AccessorValues(const tinygltf::Model& model, int index,
   return values;
 }
 
-TEST(GltfTest, GlbRoundTripsThroughTinyGltf) {
+// Two textured planes: a rectangle on z = 0 and an L-shaped hexagon on a
+// tilted plane, with random textures.
+Map TwoTexturedPlanes() {
   Map map;
   for (int i = 0; i < 2; ++i) {
     TexturedPlane p;
@@ -82,6 +84,73 @@ TEST(GltfTest, GlbRoundTripsThroughTinyGltf) {
                                    {0.1, 0.25}, {0, 0.25}};
     map.planes.push_back(p);
   }
+  return map;
+}
+
+// The primitive's material: double-sided, with the plane's texture
+// embedded as a PNG that decodes to it exactly.
+void ExpectEmbeddedTexture(const tinygltf::Model& model,
+                           const tinygltf::Primitive& primitive,
+                           const TexturedPlane& plane) {
+  const tinygltf::Material& material = model.materials.at(primitive.material);
+  EXPECT_TRUE(material.doubleSided);
+  const int texture = material.pbrMetallicRoughness.baseColorTexture.index;
+  const tinygltf::Image& image =
+      model.images.at(model.textures.at(texture).source);
+  EXPECT_EQ(image.mimeType, "image/png");
+  EXPECT_GE(image.bufferView, 0);  // embedded, not a file
+  // tinygltf decodes the PNG to RGBA: must be the BGRA texture exactly.
+  ASSERT_EQ(image.width, plane.texture.cols);
+  ASSERT_EQ(image.height, plane.texture.rows);
+  ASSERT_EQ(image.component, 4);
+  cv::Mat rgba(image.height, image.width, CV_8UC4,
+               const_cast<unsigned char*>(image.image.data()));
+  cv::Mat bgra;
+  cv::cvtColor(rgba, bgra, cv::COLOR_RGBA2BGRA);
+  EXPECT_EQ(cv::norm(bgra, plane.texture, cv::NORM_INF), 0.0);
+}
+
+// The primitive's vertices are the polygon corners in the world, its
+// texture coordinates follow the texel centre convention, and its indices
+// triangulate the polygon.
+void ExpectPlaneGeometry(const tinygltf::Model& model,
+                         const tinygltf::Primitive& primitive,
+                         const TexturedPlane& plane) {
+  const size_t n = plane.polygon.size();
+  const auto positions =
+      AccessorValues<float>(model, primitive.attributes.at("POSITION"), 3);
+  const auto texcoords =
+      AccessorValues<float>(model, primitive.attributes.at("TEXCOORD_0"), 2);
+  const auto indices = AccessorValues<uint32_t>(model, primitive.indices, 1);
+  ASSERT_EQ(positions.size(), 3 * n);
+  ASSERT_EQ(texcoords.size(), 2 * n);
+  EXPECT_EQ(indices.size(), 3 * (n - 2));
+  double max_position_error = 0, max_uv_error = 0;
+  for (size_t k = 0; k < n; ++k) {
+    const Eigen::Vector3d x = plane.frame.ToWorld(plane.polygon[k]);
+    max_position_error =
+        std::max(max_position_error,
+                 (Eigen::Vector3d(positions[3 * k], positions[3 * k + 1],
+                                  positions[3 * k + 2]) -
+                  x)
+                     .norm());
+    EXPECT_LT(std::abs(plane.plane.SignedDistance(x)), 1e-12);
+    // The texel centre convention: pixel (c, r) centre at uv
+    // ((c + 0.5) / width, (r + 0.5) / height).
+    const Eigen::Vector2d px = plane.TextureFromWorld(x);
+    const Eigen::Vector2d uv((px.x() + 0.5) / plane.texture.cols,
+                             (px.y() + 0.5) / plane.texture.rows);
+    max_uv_error = std::max(
+        max_uv_error,
+        (Eigen::Vector2d(texcoords[2 * k], texcoords[2 * k + 1]) - uv).norm());
+  }
+  EXPECT_LT(max_position_error, 1e-6);
+  EXPECT_LT(max_uv_error, 1e-6);
+  for (uint32_t index : indices) EXPECT_LT(index, n);
+}
+
+TEST(GltfTest, GlbRoundTripsThroughTinyGltf) {
+  const Map map = TwoTexturedPlanes();
   const fs::path path = fs::temp_directory_path() / "monomap_gltf_test.glb";
   WriteMapGlb(path, map);
 
@@ -102,57 +171,14 @@ TEST(GltfTest, GlbRoundTripsThroughTinyGltf) {
   ASSERT_EQ(model.buffers.size(), 1u);
 
   for (int i = 0; i < 2; ++i) {
+    SCOPED_TRACE("plane " + std::to_string(i));
     const TexturedPlane& plane = map.planes[i];
     const tinygltf::Node& node = model.nodes[i];
     EXPECT_EQ(node.name, "plane_" + std::to_string(plane.id));
     const tinygltf::Primitive& primitive = model.meshes.at(node.mesh).primitives.at(0);
     EXPECT_EQ(primitive.mode, TINYGLTF_MODE_TRIANGLES);
-    const tinygltf::Material& material = model.materials.at(primitive.material);
-    EXPECT_TRUE(material.doubleSided);
-    const int texture = material.pbrMetallicRoughness.baseColorTexture.index;
-    const tinygltf::Image& image =
-        model.images.at(model.textures.at(texture).source);
-    EXPECT_EQ(image.mimeType, "image/png");
-    EXPECT_GE(image.bufferView, 0);  // embedded, not a file
-    // tinygltf decodes the PNG to RGBA: must be the BGRA texture exactly.
-    ASSERT_EQ(image.width, plane.texture.cols);
-    ASSERT_EQ(image.height, plane.texture.rows);
-    ASSERT_EQ(image.component, 4);
-    cv::Mat rgba(image.height, image.width, CV_8UC4,
-                 const_cast<unsigned char*>(image.image.data()));
-    cv::Mat bgra;
-    cv::cvtColor(rgba, bgra, cv::COLOR_RGBA2BGRA);
-    EXPECT_EQ(cv::norm(bgra, plane.texture, cv::NORM_INF), 0.0);
-
-    const size_t n = plane.polygon.size();
-    const auto positions =
-        AccessorValues<float>(model, primitive.attributes.at("POSITION"), 3);
-    const auto texcoords =
-        AccessorValues<float>(model, primitive.attributes.at("TEXCOORD_0"), 2);
-    const auto indices = AccessorValues<uint32_t>(model, primitive.indices, 1);
-    ASSERT_EQ(positions.size(), 3 * n);
-    ASSERT_EQ(texcoords.size(), 2 * n);
-    EXPECT_EQ(indices.size(), 3 * (n - 2));
-    double max_position_error = 0, max_uv_error = 0;
-    for (size_t k = 0; k < n; ++k) {
-      const Eigen::Vector3d x = plane.frame.ToWorld(plane.polygon[k]);
-      max_position_error = std::max(
-          max_position_error,
-          (Eigen::Vector3d(positions[3 * k], positions[3 * k + 1],
-                           positions[3 * k + 2]) - x).norm());
-      EXPECT_LT(std::abs(plane.plane.SignedDistance(x)), 1e-12);
-      // The texel centre convention: pixel (c, r) centre at uv
-      // ((c + 0.5) / width, (r + 0.5) / height).
-      const Eigen::Vector2d px = plane.TextureFromWorld(x);
-      const Eigen::Vector2d uv((px.x() + 0.5) / plane.texture.cols,
-                               (px.y() + 0.5) / plane.texture.rows);
-      max_uv_error = std::max(
-          max_uv_error,
-          (Eigen::Vector2d(texcoords[2 * k], texcoords[2 * k + 1]) - uv).norm());
-    }
-    EXPECT_LT(max_position_error, 1e-6);
-    EXPECT_LT(max_uv_error, 1e-6);
-    for (uint32_t index : indices) EXPECT_LT(index, n);
+    ExpectEmbeddedTexture(model, primitive, plane);
+    ExpectPlaneGeometry(model, primitive, plane);
   }
 }
 
@@ -165,7 +191,9 @@ const tinygltf::Node* FindNode(const tinygltf::Model& model,
   return nullptr;
 }
 
-TEST(GltfTest, CameraPathPointsAndYUp) {
+// A 1 x 1 m wall on y = 2, a camera path of 5 poses and 7 coloured
+// landmarks.
+Map WallPathAndLandmarks() {
   Map map;
   TexturedPlane wall;
   wall.id = 0;
@@ -188,6 +216,76 @@ TEST(GltfTest, CameraPathPointsAndYUp) {
     l.color = {255.f, 51.f * (i % 5), 0.f};
     map.landmarks.push_back(l);
   }
+  return map;
+}
+
+// World (x, y, z) as stored in the file: (x, z, -y) if Y is up.
+Eigen::Vector3d Stored(const Eigen::Vector3d& x, bool y_up) {
+  return y_up ? Eigen::Vector3d(x.x(), x.z(), -x.y()) : x;
+}
+
+// Largest distance of the float triples xyz from the expected points.
+double MaxPointError(const std::vector<float>& xyz,
+                     const std::vector<Eigen::Vector3d>& expected) {
+  double max_error = 0;
+  for (size_t i = 0; i < expected.size(); ++i) {
+    max_error =
+        std::max(max_error,
+                 (Eigen::Vector3d(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]) -
+                  expected[i])
+                     .norm());
+  }
+  return max_error;
+}
+
+// Node "camera_path": a LINE_STRIP through the trajectory's centres.
+void ExpectCameraPath(const tinygltf::Model& model, const Map& map, bool y_up) {
+  const tinygltf::Node* path_node = FindNode(model, "camera_path");
+  ASSERT_NE(path_node, nullptr);
+  const tinygltf::Primitive& line =
+      model.meshes.at(path_node->mesh).primitives.at(0);
+  EXPECT_EQ(line.mode, TINYGLTF_MODE_LINE_STRIP);
+  const auto centres =
+      AccessorValues<float>(model, line.attributes.at("POSITION"), 3);
+  ASSERT_EQ(centres.size(), 3 * map.trajectory.size());
+  std::vector<Eigen::Vector3d> expected;
+  for (const TimedPose& p : map.trajectory) {
+    expected.push_back(Stored(p.world_from_cam.translation, y_up));
+  }
+  EXPECT_LT(MaxPointError(centres, expected), 1e-6);
+}
+
+// Node "landmarks": POINTS at the landmarks with their colours / 255.
+void ExpectLandmarkPoints(const tinygltf::Model& model, const Map& map,
+                          bool y_up) {
+  const tinygltf::Node* points_node = FindNode(model, "landmarks");
+  ASSERT_NE(points_node, nullptr);
+  const tinygltf::Primitive& points =
+      model.meshes.at(points_node->mesh).primitives.at(0);
+  EXPECT_EQ(points.mode, TINYGLTF_MODE_POINTS);
+  const auto xyz =
+      AccessorValues<float>(model, points.attributes.at("POSITION"), 3);
+  const auto rgb =
+      AccessorValues<float>(model, points.attributes.at("COLOR_0"), 3);
+  ASSERT_EQ(xyz.size(), 3 * map.landmarks.size());
+  ASSERT_EQ(rgb.size(), 3 * map.landmarks.size());
+  std::vector<Eigen::Vector3d> expected;
+  double max_color_error = 0;
+  for (size_t i = 0; i < map.landmarks.size(); ++i) {
+    expected.push_back(Stored(map.landmarks[i].x_in_world, y_up));
+    max_color_error = std::max<double>(
+        max_color_error,
+        (Eigen::Vector3f(rgb[3 * i], rgb[3 * i + 1], rgb[3 * i + 2]) -
+         map.landmarks[i].color / 255.f)
+            .norm());
+  }
+  EXPECT_LT(MaxPointError(xyz, expected), 1e-6);
+  EXPECT_LT(max_color_error, 1e-6);
+}
+
+TEST(GltfTest, CameraPathPointsAndYUp) {
+  const Map map = WallPathAndLandmarks();
+  const TexturedPlane& wall = map.planes[0];
   for (bool y_up : {false, true}) {
     SCOPED_TRACE(y_up ? "y up" : "z up");
     const fs::path path = fs::temp_directory_path() / "monomap_gltf_extras.glb";
@@ -199,59 +297,8 @@ TEST(GltfTest, CameraPathPointsAndYUp) {
         loader.LoadBinaryFromFile(&model, &error, &warning, path.string()))
         << error;
     EXPECT_EQ(model.scenes.at(0).nodes.size(), 3u);
-    // World (x, y, z) is stored as (x, z, -y) in the Y-up file.
-    auto stored = [&](const Eigen::Vector3d& x) -> Eigen::Vector3d {
-      return y_up ? Eigen::Vector3d(x.x(), x.z(), -x.y()) : x;
-    };
-
-    const tinygltf::Node* path_node = FindNode(model, "camera_path");
-    ASSERT_NE(path_node, nullptr);
-    const tinygltf::Primitive& line =
-        model.meshes.at(path_node->mesh).primitives.at(0);
-    EXPECT_EQ(line.mode, TINYGLTF_MODE_LINE_STRIP);
-    const auto centres =
-        AccessorValues<float>(model, line.attributes.at("POSITION"), 3);
-    ASSERT_EQ(centres.size(), 3 * map.trajectory.size());
-    double max_error = 0;
-    for (size_t i = 0; i < map.trajectory.size(); ++i) {
-      const Eigen::Vector3d expected =
-          stored(map.trajectory[i].world_from_cam.translation);
-      max_error = std::max(max_error,
-                           (Eigen::Vector3d(centres[3 * i], centres[3 * i + 1],
-                                            centres[3 * i + 2]) -
-                            expected)
-                               .norm());
-    }
-    EXPECT_LT(max_error, 1e-6);
-
-    const tinygltf::Node* points_node = FindNode(model, "landmarks");
-    ASSERT_NE(points_node, nullptr);
-    const tinygltf::Primitive& points =
-        model.meshes.at(points_node->mesh).primitives.at(0);
-    EXPECT_EQ(points.mode, TINYGLTF_MODE_POINTS);
-    const auto xyz =
-        AccessorValues<float>(model, points.attributes.at("POSITION"), 3);
-    const auto rgb =
-        AccessorValues<float>(model, points.attributes.at("COLOR_0"), 3);
-    ASSERT_EQ(xyz.size(), 3 * map.landmarks.size());
-    ASSERT_EQ(rgb.size(), 3 * map.landmarks.size());
-    max_error = 0;
-    double max_color_error = 0;
-    for (size_t i = 0; i < map.landmarks.size(); ++i) {
-      const Eigen::Vector3d expected = stored(map.landmarks[i].x_in_world);
-      max_error = std::max(
-          max_error,
-          (Eigen::Vector3d(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]) -
-           expected)
-              .norm());
-      max_color_error = std::max<double>(
-          max_color_error,
-          (Eigen::Vector3f(rgb[3 * i], rgb[3 * i + 1], rgb[3 * i + 2]) -
-           map.landmarks[i].color / 255.f)
-              .norm());
-    }
-    EXPECT_LT(max_error, 1e-6);
-    EXPECT_LT(max_color_error, 1e-6);
+    ExpectCameraPath(model, map, y_up);
+    ExpectLandmarkPoints(model, map, y_up);
 
     // The wall's corners and normal in the file's axes.
     const tinygltf::Primitive& quad =
@@ -261,15 +308,16 @@ TEST(GltfTest, CameraPathPointsAndYUp) {
     const auto normals =
         AccessorValues<float>(model, quad.attributes.at("NORMAL"), 3);
     ASSERT_EQ(corners.size(), 12u);
-    max_error = 0;
+    double max_error = 0;
     for (size_t k = 0; k < 4; ++k) {
       const Eigen::Vector3d c(corners[3 * k], corners[3 * k + 1],
                               corners[3 * k + 2]);
       const Eigen::Vector3d n(normals[3 * k], normals[3 * k + 1],
                               normals[3 * k + 2]);
       max_error = std::max(
-          {max_error, (c - stored(wall.frame.ToWorld(wall.polygon[k]))).norm(),
-           (n - stored(Eigen::Vector3d::UnitY())).norm()});
+          {max_error,
+           (c - Stored(wall.frame.ToWorld(wall.polygon[k]), y_up)).norm(),
+           (n - Stored(Eigen::Vector3d::UnitY(), y_up)).norm()});
     }
     EXPECT_LT(max_error, 1e-6);
   }

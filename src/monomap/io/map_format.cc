@@ -175,28 +175,18 @@ Camera ReadCamera(const JsonFields& f, const json& root) {
   return camera;
 }
 
-TexturedPlane ReadPlane(const JsonFields& f, const json& p,
-                        const std::string& field, const fs::path& dir) {
-  if (!p.is_object()) f.Fail(field, "expected an object");
-  TexturedPlane plane;
-  plane.id = f.Int(p, field, "id");
-  // -1 means "no plane" in points.ply.
-  if (plane.id < 0) f.Fail(JsonFields::Join(field, "id"), "must be >= 0");
-  plane.plane.normal = f.Vector<3>(p, field, "normal");
-  const double normal_norm = plane.plane.normal.norm();
-  if (std::abs(normal_norm - 1.0) > kMapUnitTolerance) {
-    f.Fail(JsonFields::Join(field, "normal"),
-           "not of unit length (norm " + std::to_string(normal_norm) + ")");
-  }
-  plane.plane.offset = f.Number(p, field, "offset");
-  plane.frame.origin = f.Vector<3>(p, field, "origin");
-  plane.frame.u_axis = f.Vector<3>(p, field, "u_axis");
-  plane.frame.v_axis = f.Vector<3>(p, field, "v_axis");
-  const Eigen::Vector3d& n = plane.plane.normal;
+// The plane frame's axes and origin, checked against the plane read
+// already: unit axes in the plane, orthogonal, origin on the plane.
+void ReadPlaneFrame(const JsonFields& f, const json& p,
+                    const std::string& field, TexturedPlane* plane) {
+  plane->frame.origin = f.Vector<3>(p, field, "origin");
+  plane->frame.u_axis = f.Vector<3>(p, field, "u_axis");
+  plane->frame.v_axis = f.Vector<3>(p, field, "v_axis");
+  const Eigen::Vector3d& n = plane->plane.normal;
   const struct {
     const char* key;
     const Eigen::Vector3d& axis;
-  } axes[] = {{"u_axis", plane.frame.u_axis}, {"v_axis", plane.frame.v_axis}};
+  } axes[] = {{"u_axis", plane->frame.u_axis}, {"v_axis", plane->frame.v_axis}};
   for (const auto& a : axes) {
     const std::string axis_field = JsonFields::Join(field, a.key);
     if (std::abs(a.axis.norm() - 1.0) > kMapUnitTolerance) {
@@ -208,35 +198,39 @@ TexturedPlane ReadPlane(const JsonFields& f, const json& p,
                              std::to_string(a.axis.dot(n)) + ")");
     }
   }
-  if (std::abs(plane.frame.u_axis.dot(plane.frame.v_axis)) >
+  if (std::abs(plane->frame.u_axis.dot(plane->frame.v_axis)) >
       kMapUnitTolerance) {
     f.Fail(JsonFields::Join(field, "v_axis"), "not orthogonal to u_axis");
   }
-  if (std::abs(plane.plane.SignedDistance(plane.frame.origin)) >
-      kMapOnPlaneToleranceM * std::max(1.0, std::abs(plane.plane.offset))) {
+  const double distance = plane->plane.SignedDistance(plane->frame.origin);
+  if (std::abs(distance) >
+      kMapOnPlaneToleranceM * std::max(1.0, std::abs(plane->plane.offset))) {
     f.Fail(JsonFields::Join(field, "origin"),
-           "not on the plane (distance " +
-               std::to_string(plane.plane.SignedDistance(plane.frame.origin)) +
-               " m)");
+           "not on the plane (distance " + std::to_string(distance) + " m)");
   }
-  plane.pixels_per_meter = f.Number(p, field, "pixels_per_meter");
-  if (plane.pixels_per_meter <= 0) {
-    f.Fail(JsonFields::Join(field, "pixels_per_meter"), "must be positive");
-  }
+}
 
+Polygon2d ReadPolygon(const JsonFields& f, const json& p,
+                      const std::string& field) {
   const std::string polygon_field = JsonFields::Join(field, "polygon");
   const json& polygon = f.Array(p, field, "polygon");
   if (polygon.size() < 3) {
     f.Fail(polygon_field, "needs at least 3 vertices, got " +
                               std::to_string(polygon.size()));
   }
+  Polygon2d vertices;
   for (size_t i = 0; i < polygon.size(); ++i) {
-    plane.polygon.push_back(
+    vertices.push_back(
         f.Vector<2>(polygon[i], JsonFields::Index(polygon_field, i)));
   }
+  return vertices;
+}
 
+std::vector<PlaneFeature> ReadPlaneFeatures(const JsonFields& f, const json& p,
+                                            const std::string& field) {
   const std::string features_field = JsonFields::Join(field, "features");
   const json& features = f.Array(p, field, "features");
+  std::vector<PlaneFeature> out;
   for (size_t i = 0; i < features.size(); ++i) {
     const std::string ff = JsonFields::Index(features_field, i);
     if (!features[i].is_object()) f.Fail(ff, "expected an object");
@@ -244,10 +238,14 @@ TexturedPlane ReadPlane(const JsonFields& f, const json& p,
     feature.id = f.Integer(features[i], ff, "id");
     feature.x_in_world = f.Vector<3>(features[i], ff, "xyz");
     feature.texture_px = f.Vector<2>(features[i], ff, "texture_px");
-    plane.features.push_back(feature);
+    out.push_back(feature);
   }
+  return out;
+}
 
-  // The texture: a plain file name inside the map directory.
+// The texture (BGRA): a plain file name inside the map directory.
+cv::Mat ReadPlaneTexture(const JsonFields& f, const json& p,
+                         const std::string& field, const fs::path& dir) {
   const std::string texture_field = JsonFields::Join(field, "texture");
   const std::string texture_name = f.String(p, field, "texture");
   const fs::path texture_path(texture_name);
@@ -262,11 +260,36 @@ TexturedPlane ReadPlane(const JsonFields& f, const json& p,
   if (!fs::is_regular_file(full, ec)) {
     f.Fail(texture_field, "texture file " + full.string() + " is missing");
   }
-  plane.texture = ToBgra(ReadImageFile(full, cv::IMREAD_UNCHANGED));
-  if (plane.texture.empty()) {
+  cv::Mat texture = ToBgra(ReadImageFile(full, cv::IMREAD_UNCHANGED));
+  if (texture.empty()) {
     throw InputError(full.string() +
                      ": texture must be an 8-bit grey, BGR or BGRA image");
   }
+  return texture;
+}
+
+TexturedPlane ReadPlane(const JsonFields& f, const json& p,
+                        const std::string& field, const fs::path& dir) {
+  if (!p.is_object()) f.Fail(field, "expected an object");
+  TexturedPlane plane;
+  plane.id = f.Int(p, field, "id");
+  // -1 means "no plane" in points.ply.
+  if (plane.id < 0) f.Fail(JsonFields::Join(field, "id"), "must be >= 0");
+  plane.plane.normal = f.Vector<3>(p, field, "normal");
+  const double normal_norm = plane.plane.normal.norm();
+  if (std::abs(normal_norm - 1.0) > kMapUnitTolerance) {
+    f.Fail(JsonFields::Join(field, "normal"),
+           "not of unit length (norm " + std::to_string(normal_norm) + ")");
+  }
+  plane.plane.offset = f.Number(p, field, "offset");
+  ReadPlaneFrame(f, p, field, &plane);
+  plane.pixels_per_meter = f.Number(p, field, "pixels_per_meter");
+  if (plane.pixels_per_meter <= 0) {
+    f.Fail(JsonFields::Join(field, "pixels_per_meter"), "must be positive");
+  }
+  plane.polygon = ReadPolygon(f, p, field);
+  plane.features = ReadPlaneFeatures(f, p, field);
+  plane.texture = ReadPlaneTexture(f, p, field, dir);
   return plane;
 }
 

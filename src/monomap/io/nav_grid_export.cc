@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "monomap/geometry/polygon.h"
+#include "monomap/util/angles.h"
 #include "monomap/util/error.h"
 #include "monomap/util/file.h"
 
@@ -40,7 +41,7 @@ PlaneRole Classify(const TexturedPlane& p, const NavGridOptions& o) {
     z_hi = std::max(z_hi, z);
   }
   const bool horizontal = std::abs(p.plane.normal.z()) >=
-                          std::cos(o.horizontal_max_tilt_deg * M_PI / 180.0);
+                          std::cos(DegToRadMulDiv(o.horizontal_max_tilt_deg));
   if (horizontal && z_hi < o.min_z_m) return PlaneRole::kFloor;
   if (z_hi >= o.min_z_m && z_lo <= o.max_z_m) return PlaneRole::kObstacle;
   return PlaneRole::kIgnored;

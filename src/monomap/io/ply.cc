@@ -143,6 +143,63 @@ void CheckElementCounts(const PlyHeader& header, size_t data_bytes,
   }
 }
 
+// The header lines below: "format FORMAT 1.0", "element NAME COUNT",
+// "property TYPE NAME" or "property list COUNT_TYPE TYPE NAME" (tokens,
+// at line_number of file).
+PlyFormat ParseFormatLine(const std::vector<std::string>& tokens,
+                          const std::string& file, int line_number) {
+  if (tokens.size() != 3) {
+    throw InputError(file, line_number, "malformed PLY format line");
+  }
+  if (tokens[1] == "ascii") return PlyFormat::kAscii;
+  if (tokens[1] == "binary_little_endian") {
+    return PlyFormat::kBinaryLittleEndian;
+  }
+  throw InputError(file, line_number,
+                   "unsupported PLY format '" + tokens[1] +
+                       "' (ascii or binary_little_endian)");
+}
+
+PlyElement ParseElementLine(const std::vector<std::string>& tokens,
+                            const std::string& file, int line_number) {
+  PlyElement element;
+  if (tokens.size() != 3) {
+    throw InputError(file, line_number, "malformed PLY element line");
+  }
+  element.name = tokens[1];
+  const char* end = tokens[2].data() + tokens[2].size();
+  const auto r = std::from_chars(tokens[2].data(), end, element.count);
+  if (r.ec != std::errc() || r.ptr != end || element.count < 0) {
+    throw InputError(file, line_number,
+                     "bad element count '" + tokens[2] + "'");
+  }
+  return element;
+}
+
+PlyProperty ParsePropertyLine(const std::vector<std::string>& tokens,
+                              const std::string& line, const std::string& file,
+                              int line_number) {
+  PlyProperty property;
+  bool ok = false;
+  if (tokens.size() == 5 && tokens[1] == "list") {
+    property.is_list = true;
+    ok = ParsePlyType(tokens[2], &property.count_type) &&
+         ParsePlyType(tokens[3], &property.type);
+    // A list length must be an integer.
+    ok = ok && property.count_type != PlyType::kFloat32 &&
+         property.count_type != PlyType::kFloat64;
+    property.name = tokens[4];
+  } else if (tokens.size() == 3) {
+    ok = ParsePlyType(tokens[1], &property.type);
+    property.name = tokens[2];
+  }
+  if (!ok) {
+    throw InputError(file, line_number,
+                     "malformed or unsupported PLY property '" + line + "'");
+  }
+  return property;
+}
+
 PlyHeader ParseHeader(const std::string& data, const std::string& file) {
   PlyHeader header;
   size_t pos = 0;
@@ -172,57 +229,17 @@ PlyHeader ParseHeader(const std::string& data, const std::string& file) {
     if (keyword == "end_header") break;
     if (keyword == "comment" || keyword == "obj_info") continue;
     if (keyword == "format") {
-      if (tokens.size() != 3) {
-        throw InputError(file, line_number, "malformed PLY format line");
-      }
-      if (tokens[1] == "ascii") {
-        header.format = PlyFormat::kAscii;
-      } else if (tokens[1] == "binary_little_endian") {
-        header.format = PlyFormat::kBinaryLittleEndian;
-      } else {
-        throw InputError(file, line_number,
-                         "unsupported PLY format '" + tokens[1] +
-                             "' (ascii or binary_little_endian)");
-      }
+      header.format = ParseFormatLine(tokens, file, line_number);
       have_format = true;
     } else if (keyword == "element") {
-      PlyElement element;
-      if (tokens.size() != 3) {
-        throw InputError(file, line_number, "malformed PLY element line");
-      }
-      element.name = tokens[1];
-      const char* end = tokens[2].data() + tokens[2].size();
-      const auto r = std::from_chars(tokens[2].data(), end, element.count);
-      if (r.ec != std::errc() || r.ptr != end || element.count < 0) {
-        throw InputError(file, line_number,
-                         "bad element count '" + tokens[2] + "'");
-      }
-      header.elements.push_back(element);
+      header.elements.push_back(ParseElementLine(tokens, file, line_number));
     } else if (keyword == "property") {
       if (header.elements.empty()) {
         throw InputError(file, line_number,
                          "PLY property before any element");
       }
-      PlyProperty property;
-      bool ok = false;
-      if (tokens.size() == 5 && tokens[1] == "list") {
-        property.is_list = true;
-        ok = ParsePlyType(tokens[2], &property.count_type) &&
-             ParsePlyType(tokens[3], &property.type);
-        // A list length must be an integer.
-        ok = ok && property.count_type != PlyType::kFloat32 &&
-             property.count_type != PlyType::kFloat64;
-        property.name = tokens[4];
-      } else if (tokens.size() == 3) {
-        ok = ParsePlyType(tokens[1], &property.type);
-        property.name = tokens[2];
-      }
-      if (!ok) {
-        throw InputError(file, line_number,
-                         "malformed or unsupported PLY property '" + line +
-                             "'");
-      }
-      header.elements.back().properties.push_back(property);
+      header.elements.back().properties.push_back(
+          ParsePropertyLine(tokens, line, file, line_number));
     } else {
       throw InputError(file, line_number,
                        "unknown PLY header keyword '" + keyword + "'");

@@ -10,6 +10,7 @@
 #include "monomap/io/dataset.h"
 #include "monomap/io/dataset_writer.h"
 #include "monomap/io/trajectory_io.h"
+#include "monomap/util/angles.h"
 #include "monomap/util/error.h"
 #include "monomap/util/file.h"
 
@@ -144,8 +145,8 @@ std::vector<Rigid3d> SimulateOdometry(const std::vector<Rigid3d>& gt,
     const Eigen::Vector3d t = (1.0 + o.scale_error) * step.translation +
                               o.translation_noise * length * t_noise;
     const Eigen::Quaterniond r =
-        QuaternionFromRotationVector(o.rotation_noise_deg_per_m * M_PI / 180 *
-                                     length * r_noise) *
+        QuaternionFromRotationVector(
+            DegToRadMulDiv(o.rotation_noise_deg_per_m) * length * r_noise) *
         step.rotation;
     odo.push_back(odo.back() * Rigid3d(r, t));
   }

@@ -2,20 +2,20 @@
 
 #include <gtest/gtest.h>
 
-#include "monomap/localization/test_scene.h"
+#include "monomap/sim/room_scene.h"
 #include "monomap/util/error.h"
 
 namespace monomap {
 namespace {
 
 TEST(LiveFrame, PreparesEachAskedSizeOnce) {
-  const Map map = test_scene::RoomMap();
+  const Map map = testing::RoomMap();
   const Renderer renderer(map);
-  const Camera camera = test_scene::LiveCamera();
+  const Camera camera = testing::LiveCamera();
   const MeasurementModel model(&renderer, camera);
-  const cv::Mat raw = test_scene::LiveImage(
+  const cv::Mat raw = testing::LiveImage(
       renderer, camera,
-      WorldFromCamOfBase({0.5, 0.2, 0.4}, test_scene::BaseFromCam()), 0.9, 5,
+      WorldFromCamOfBase({0.5, 0.2, 0.4}, testing::BaseFromCam()), 0.9, 5,
       2.0, 1);
   LiveFrameSizes sizes;
   sizes.measurement = {80, 60};

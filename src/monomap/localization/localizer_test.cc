@@ -6,7 +6,7 @@
 
 #include <gtest/gtest.h>
 
-#include "monomap/localization/test_scene.h"
+#include "monomap/sim/room_scene.h"
 #include "monomap/util/error.h"
 
 namespace monomap {
@@ -47,9 +47,9 @@ Drive MakeDrive(const Pose2d& start, int steps, double step_m,
 class LocalizerTest : public ::testing::Test {
  public:
   LocalizerTest()
-      : map_(test_scene::RoomMap()),
-        camera_(test_scene::LiveCamera()),
-        mount_(test_scene::BaseFromCam()),
+      : map_(testing::RoomMap()),
+        camera_(testing::LiveCamera()),
+        mount_(testing::BaseFromCam()),
         renderer_(map_) {}
 
   // Runs the filter over the drive; returns the per-step translation
@@ -59,7 +59,7 @@ class LocalizerTest : public ::testing::Test {
     std::vector<double> errors;
     for (size_t i = 0; i < drive.truth.size(); ++i) {
       const Rigid3d truth = WorldFromCamOfBase(drive.truth[i], mount_);
-      const cv::Mat raw = test_scene::LiveImage(
+      const cv::Mat raw = testing::LiveImage(
           renderer_, camera_, truth, 0.85 + 0.1 * std::sin(i * 0.7), 10, 2.0,
           100 + i);
       OdometryIncrement odo;

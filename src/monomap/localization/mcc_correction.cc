@@ -6,13 +6,12 @@
 #include <cmath>
 #include <numeric>
 
+#include "monomap/util/angles.h"
 #include "monomap/util/error.h"
 
 namespace monomap {
 
 namespace {
-
-constexpr double kDegToRad = M_PI / 180.0;
 
 // options.refinement at the live camera's aspect, never larger than the
 // camera: upsampling the live image would only blur the tracks.
@@ -66,7 +65,7 @@ MccCorrectionStats MccCorrection::CorrectParticles(
   if (options_.top_k <= 0) return stats;
   const std::vector<size_t> order =
       SpreadHeaviest(*particles, static_cast<size_t>(options_.top_k),
-                     options_.spread_m, options_.spread_deg * kDegToRad);
+                     options_.spread_m, DegToRad(options_.spread_deg));
   const size_t k = order.size();
   std::vector<int> accepted(k, 0);
   tbb::parallel_for(size_t{0}, k, [&](size_t j) {
@@ -105,7 +104,7 @@ bool MccCorrection::RefineEstimate(const LiveFrame& live,
 
 int MccCorrection::MergeDuplicates(std::vector<Particle>* particles) const {
   return MergeDuplicateParticles(particles, options_.merge_translation_m,
-                                 options_.merge_rotation_deg * kDegToRad);
+                                 DegToRad(options_.merge_rotation_deg));
 }
 
 }  // namespace monomap

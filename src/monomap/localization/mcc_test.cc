@@ -8,7 +8,7 @@
 
 #include "monomap/localization/measurement_model.h"
 #include "monomap/localization/particle_filter.h"
-#include "monomap/localization/test_scene.h"
+#include "monomap/sim/room_scene.h"
 
 namespace monomap {
 namespace {
@@ -28,9 +28,9 @@ class MccTest : public ::testing::Test {
     for (const Pose2d& base : {Pose2d{0.3, 0.2, 0.3}, Pose2d{1.2, -0.5, -0.8},
                                Pose2d{0.5, 0.6, 2.5}}) {
       View v;
-      v.truth = WorldFromCamOfBase(base, test_scene::BaseFromCam());
+      v.truth = WorldFromCamOfBase(base, testing::BaseFromCam());
       const cv::Mat raw =
-          test_scene::LiveImage(renderer_, camera_, v.truth, 0.8, 15, 2.0, ++n);
+          testing::LiveImage(renderer_, camera_, v.truth, 0.8, 15, 2.0, ++n);
       v.live = LiveImagePreparer::Downscale(
           prep_.Undistort(raw), mcc_.options().width, mcc_.options().height);
       views.push_back(std::move(v));
@@ -38,9 +38,9 @@ class MccTest : public ::testing::Test {
     return views;
   }
 
-  const Map map_ = test_scene::RoomMap();
+  const Map map_ = testing::RoomMap();
   const Renderer renderer_{map_};
-  const Camera camera_ = test_scene::LiveCamera();
+  const Camera camera_ = testing::LiveCamera();
   const MonteCarloCorrector mcc_{&renderer_, camera_};
   const LiveImagePreparer prep_{camera_};
 };
@@ -94,9 +94,9 @@ TEST_F(MccTest, CorrectsTwentyCentimetresAlongTheViewAxis) {
 }
 
 TEST(Mcc, RefusesWithoutMap) {
-  const Map map = test_scene::RoomMap();
+  const Map map = testing::RoomMap();
   const Renderer renderer(map);
-  const MonteCarloCorrector mcc(&renderer, test_scene::LiveCamera());
+  const MonteCarloCorrector mcc(&renderer, testing::LiveCamera());
   const cv::Mat live(120, 160, CV_8UC1, cv::Scalar(90));
   // Looking up from above the walls: nothing rendered, nothing corrected.
   const Rigid3d up(QuaternionFromRotationVector({M_PI / 2, 0, 0}),

@@ -5,7 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "monomap/localization/particle_filter.h"
-#include "monomap/localization/test_scene.h"
+#include "monomap/sim/room_scene.h"
 #include "monomap/util/error.h"
 
 namespace monomap {
@@ -16,9 +16,9 @@ constexpr double kDeg = M_PI / 180.0;
 class MeasurementTest : public ::testing::Test {
  protected:
   MeasurementTest()
-      : map_(test_scene::RoomMap()),
+      : map_(testing::RoomMap()),
         renderer_(map_),
-        camera_(test_scene::LiveCamera()),
+        camera_(testing::LiveCamera()),
         model_(&renderer_, camera_) {}
 
   Map map_;
@@ -28,12 +28,12 @@ class MeasurementTest : public ::testing::Test {
 };
 
 TEST_F(MeasurementTest, TruePoseBeatsDisplacedPoses) {
-  const Rigid3d mount = test_scene::BaseFromCam();
+  const Rigid3d mount = testing::BaseFromCam();
   for (const Pose2d& base : {Pose2d{0.3, 0.2, 0.3}, Pose2d{1.2, -0.5, -0.8},
                              Pose2d{0.5, 0.6, 2.5}}) {
     const Rigid3d truth = WorldFromCamOfBase(base, mount);
     // Gain and offset change plus sensor noise.
-    const cv::Mat raw = test_scene::LiveImage(renderer_, camera_, truth, 0.7,
+    const cv::Mat raw = testing::LiveImage(renderer_, camera_, truth, 0.7,
                                               25, 3.0, 1);
     const cv::Mat live = model_.PrepareLive(raw);
     ASSERT_EQ(live.cols, 80);
@@ -63,9 +63,9 @@ TEST_F(MeasurementTest, TruePoseBeatsDisplacedPoses) {
 
 TEST_F(MeasurementTest, UndistortionMatchesPinholeRender) {
   const Rigid3d truth =
-      WorldFromCamOfBase({0.3, 0.1, 0.2}, test_scene::BaseFromCam());
+      WorldFromCamOfBase({0.3, 0.1, 0.2}, testing::BaseFromCam());
   const cv::Mat raw =
-      test_scene::LiveImage(renderer_, camera_, truth, 1.0, 0, 0.0, 1);
+      testing::LiveImage(renderer_, camera_, truth, 1.0, 0, 0.0, 1);
   const cv::Mat undist = model_.preparer().Undistort(raw);
   cv::Mat pinhole, depth;
   renderer_.Render(camera_.Pinhole(), truth, &pinhole, &depth);

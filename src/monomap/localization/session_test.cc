@@ -6,7 +6,7 @@
 
 #include <gtest/gtest.h>
 
-#include "monomap/localization/test_scene.h"
+#include "monomap/sim/room_scene.h"
 #include "monomap/util/error.h"
 
 namespace monomap {
@@ -38,7 +38,7 @@ Drive MakeDrive(const Renderer& renderer, const Camera& camera,
     d.truth.push_back(WorldFromCamOfBase(truth, mount));
     SessionFrame f;
     f.stamp = 0.1 * i;
-    f.image = test_scene::LiveImage(renderer, camera, d.truth.back(), 0.9, 10,
+    f.image = testing::LiveImage(renderer, camera, d.truth.back(), 0.9, 10,
                                     2.0, 100 + i);
     f.odom_base = odometry;
     f.odom_from_cam = WorldFromCamOfBase(odometry, mount);
@@ -50,9 +50,9 @@ Drive MakeDrive(const Renderer& renderer, const Camera& camera,
 class SessionTest : public ::testing::Test {
  public:
   SessionTest()
-      : map_(std::make_shared<Map>(test_scene::RoomMap())),
-        camera_(test_scene::LiveCamera()),
-        mount_(test_scene::BaseFromCam()),
+      : map_(std::make_shared<Map>(testing::RoomMap())),
+        camera_(testing::LiveCamera()),
+        mount_(testing::BaseFromCam()),
         renderer_(*map_),
         drive_(MakeDrive(renderer_, camera_, mount_, 25)) {}
 

@@ -8,7 +8,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "monomap/io/map_format.h"
-#include "monomap/localization/test_scene.h"
+#include "monomap/sim/room_scene.h"
 #include "monomap/util/error.h"
 
 namespace monomap {
@@ -31,9 +31,9 @@ class LocalizationPipelineTest : public ::testing::Test {
     dir_ = std::filesystem::temp_directory_path() /
            ("monomap_localization_pipeline_test_" + std::to_string(::getpid()));
     std::filesystem::create_directories(dir_);
-    map_ = test_scene::RoomMap();
-    const Camera camera = test_scene::LiveCamera();
-    const Rigid3d mount = test_scene::BaseFromCam();
+    map_ = testing::RoomMap();
+    const Camera camera = testing::LiveCamera();
+    const Rigid3d mount = testing::BaseFromCam();
     const Renderer renderer(map_);
     ds_.root = dir_;
     ds_.camera = camera;
@@ -46,7 +46,7 @@ class LocalizationPipelineTest : public ::testing::Test {
       f.image_path = dir_ / ("f" + std::to_string(i) + ".png");
       truth_.push_back(WorldFromCamOfBase(truth, mount));
       cv::imwrite(f.image_path.string(),
-                  test_scene::LiveImage(renderer, camera, truth_.back(), 0.9, 5,
+                  testing::LiveImage(renderer, camera, truth_.back(), 0.9, 5,
                                         2.0, i));
       f.odometry_base = odometry;
       f.odometry_world_from_cam = WorldFromCamOfBase(odometry, mount);

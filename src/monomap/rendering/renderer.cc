@@ -263,11 +263,275 @@ std::vector<RenderStats> Renderer::RenderBatch(
   return stats;
 }
 
+namespace {
+
+// A plane as one camera sees it.
+struct PlaneProjection {
+  Eigen::Matrix3d texel_from_pixel;
+  std::array<Eigen::Vector2d, 8> poly;  // image polygon of the scanned region
+  int n = 0;                            // vertices of poly
+  int row0 = 0, row1 = 0;               // rows it may cover
+};
+
+// The scanned region's corners (camera frame), clipped to the near plane
+// and projected: a convex polygon, whose extent per row bounds the pixels
+// to visit. False if nothing of it is in the image.
+bool ProjectScanRegion(const std::array<Eigen::Vector3d, 4>& corners,
+                       const Camera& camera, double z_near,
+                       PlaneProjection* proj) {
+  std::array<Eigen::Vector3d, 8> clipped;
+  const int n = ClipNear(corners, z_near, &clipped);
+  if (n < 3) return false;
+  std::array<Eigen::Vector2d, 8>& poly = proj->poly;
+  double vmin = std::numeric_limits<double>::infinity();
+  double vmax = -vmin, umin_all = vmin, umax_all = -vmin;
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Vector3d& x = clipped[i];
+    poly[i] = {camera.fx * x.x() / x.z() + camera.cx,
+               camera.fy * x.y() / x.z() + camera.cy};
+    vmin = std::min(vmin, poly[i].y());
+    vmax = std::max(vmax, poly[i].y());
+    umin_all = std::min(umin_all, poly[i].x());
+    umax_all = std::max(umax_all, poly[i].x());
+  }
+  const int height = camera.height;
+  if (vmax < -1 || vmin > height || umax_all < -1 || umin_all > camera.width) {
+    return false;
+  }
+  proj->n = n;
+  proj->row0 = std::max(0, static_cast<int>(std::floor(vmin - 1)));
+  proj->row1 = std::min(height - 1, static_cast<int>(std::ceil(vmax + 1)));
+  return true;
+}
+
+// Projects the plane region [st_min, st_max] (metres in the plane frame)
+// with cam_from_world = [rot | trans]. False if the plane faces away (or
+// is seen edge-on) or the region is out of view.
+bool ProjectPlane(const PlaneFrame& frame, double ppm,
+                  const Eigen::Vector2d& st_min, const Eigen::Vector2d& st_max,
+                  const Eigen::Matrix3d& rot, const Eigen::Vector3d& trans,
+                  const Camera& camera, const Eigen::Matrix3d& k,
+                  const RendererOptions& options, PlaneProjection* proj) {
+  const Eigen::Vector3d u_c = rot * frame.u_axis;
+  const Eigen::Vector3d v_c = rot * frame.v_axis;
+  const Eigen::Vector3d o_c = rot * frame.origin + trans;
+  // Camera centre on the normal's side <=> n . (0 - o) > 0.
+  const double side = -u_c.cross(v_c).dot(o_c);
+  if (options.cull_back_faces ? side <= 1e-12 : std::abs(side) <= 1e-12) {
+    return false;
+  }
+  // pixel_from_texel = K [R u, R v, R o + t] with texel centres at
+  // (c + 0.5) / ppm. Its inverse maps pixels to homogeneous texels whose
+  // third coordinate is exactly 1/z.
+  Eigen::Matrix3d m;
+  m.col(0) = u_c / ppm;
+  m.col(1) = v_c / ppm;
+  m.col(2) = o_c + 0.5 * (u_c + v_c) / ppm;
+  proj->texel_from_pixel = (k * m).inverse();
+  if (!proj->texel_from_pixel.allFinite()) return false;
+  const std::array<Eigen::Vector3d, 4> corners = {
+      o_c + st_min.x() * u_c + st_min.y() * v_c,
+      o_c + st_max.x() * u_c + st_min.y() * v_c,
+      o_c + st_max.x() * u_c + st_max.y() * v_c,
+      o_c + st_min.x() * u_c + st_max.y() * v_c};
+  return ProjectScanRegion(corners, camera, options.z_near_m, proj);
+}
+
+// Extent [lo, hi] of the polygon within the band of rows [v - 1, v + 1];
+// lo > hi if the band misses it.
+void PolygonRowExtent(const std::array<Eigen::Vector2d, 8>& poly, int n, int v,
+                      double* lo_out, double* hi_out) {
+  const double b0 = v - 1.0, b1 = v + 1.0;
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Vector2d& p = poly[i];
+    const Eigen::Vector2d& q = poly[(i + 1) % n];
+    if (p.y() >= b0 && p.y() <= b1) {
+      lo = std::min(lo, p.x());
+      hi = std::max(hi, p.x());
+    }
+    for (double b : {b0, b1}) {
+      if ((p.y() - b) * (q.y() - b) < 0) {
+        const double x =
+            p.x() + (b - p.y()) / (q.y() - p.y()) * (q.x() - p.x());
+        lo = std::min(lo, x);
+        hi = std::max(hi, x);
+      }
+    }
+  }
+  *lo_out = lo;
+  *hi_out = hi;
+}
+
+// Mip level of the span [s0, s1] of row v from the texel footprint at its
+// centre: rho^2 = |det d texel / d pixel| (area) or the squared longest of
+// its columns; level = round(log2 rho + bias), within the pyramid.
+int MipLevel(const Eigen::Matrix3d& texel_from_pixel, int s0, int s1, int v,
+             int num_levels, bool area_footprint, double bias) {
+  if (num_levels <= 1) return 0;
+  const double uc = 0.5 * (s0 + s1);
+  const Eigen::Vector3d t = texel_from_pixel * Eigen::Vector3d(uc, v, 1);
+  if (!(t.z() > 0)) return 0;
+  const double x = t.x() / t.z(), y = t.y() / t.z();
+  const Eigen::Matrix3d& hd = texel_from_pixel;
+  const double dxdu = (hd(0, 0) - x * hd(2, 0)) / t.z();
+  const double dydu = (hd(1, 0) - y * hd(2, 0)) / t.z();
+  const double dxdv = (hd(0, 1) - x * hd(2, 1)) / t.z();
+  const double dydv = (hd(1, 1) - y * hd(2, 1)) / t.z();
+  const double rho2 = area_footprint ? std::abs(dxdu * dydv - dydu * dxdv)
+                                     : std::max(dxdu * dxdu + dydu * dydu,
+                                                dxdv * dxdv + dydv * dydv);
+  const double lambda = 0.5 * std::log2(rho2) + bias;
+  if (!(lambda > 0.5)) return 0;
+  return std::min(num_levels - 1, static_cast<int>(std::floor(lambda + 0.5)));
+}
+
+// What every drawn pixel shares: the buffers and the options.
+struct Raster {
+  int width = 0;
+  float* zbuf = nullptr;  // inverse depths, 0 = background
+  cv::Mat* image = nullptr;
+  float inv_near = 0;
+  float alpha_min = 0;
+  double mip_bias = 0;
+  bool area_footprint = false;
+};
+
+// One image row: the homography's terms that depend on the row only, and
+// the row's buffers.
+struct RowTarget {
+  float x_row, y_row, w_row;
+  float* zrow;
+  uint8_t* out;
+};
+
+// Draws the pixels [s0, s1] of a row from mip level `level`, bilinearly,
+// where the plane is the nearest surface so far. True if any was drawn.
+template <int C>
+bool DrawSpan(const Level& lev, int level, const Eigen::Matrix3f& h,
+              const RowTarget& row, int s0, int s1, const Raster& raster) {
+  constexpr int kOut = C == 2 ? 1 : 3;
+  // Level-0 texel x -> padded level-L coordinate (x + 0.5) / 2^L - 0.5 + 1.
+  const float scale = std::ldexp(1.f, -level);
+  const float offset = 0.5f * scale + 0.5f;
+  const float x_max = static_cast<float>(lev.width + 1);
+  const float y_max = static_cast<float>(lev.height + 1);
+  const float* texels = lev.data.data();
+  const int stride = lev.stride;
+  bool drawn = false;
+  for (int u = s0; u <= s1; ++u) {
+    const float fu = static_cast<float>(u);
+    const float w = row.w_row + h(2, 0) * fu;
+    // Nearest surface wins; 1/z <= 0 is behind the camera.
+    if (!(w > row.zrow[u]) || w > raster.inv_near) continue;
+    const float inv_w = 1.f / w;
+    const float x = (row.x_row + h(0, 0) * fu) * inv_w * scale + offset;
+    const float y = (row.y_row + h(1, 0) * fu) * inv_w * scale + offset;
+    if (!(x >= 0.f && x < x_max && y >= 0.f && y < y_max)) continue;
+    const int xi = static_cast<int>(x);
+    const int yi = static_cast<int>(y);
+    const float fx = x - xi, fy = y - yi;
+    const float* p0 = texels + yi * stride + xi * C;
+    const float* p1 = p0 + stride;
+    float val[C];
+    for (int c = 0; c < C; ++c) {
+      const float top = p0[c] + fx * (p0[C + c] - p0[c]);
+      const float bottom = p1[c] + fx * (p1[C + c] - p1[c]);
+      val[c] = top + fy * (bottom - top);
+    }
+    const float alpha = val[C - 1];
+    if (alpha < raster.alpha_min) continue;
+    const float inv_alpha = 1.f / alpha;
+    row.zrow[u] = w;
+    uint8_t* o = row.out + u * kOut;
+    for (int c = 0; c < kOut; ++c) {
+      o[c] = static_cast<uint8_t>(std::min(255.f, val[c] * inv_alpha + 0.5f));
+    }
+    drawn = true;
+  }
+  return drawn;
+}
+
+// Draws rows [row0, row1] of one plane, span by span. True if any pixel
+// was drawn.
+template <int C>
+bool DrawPlaneRows(const std::vector<Level>& levels,
+                   const PlaneProjection& proj, int row0, int row1,
+                   const Raster& raster) {
+  const Eigen::Matrix3f h = proj.texel_from_pixel.cast<float>();
+  const int num_levels = static_cast<int>(levels.size());
+  bool drawn = false;
+  for (int v = row0; v <= row1; ++v) {
+    double lo, hi;
+    PolygonRowExtent(proj.poly, proj.n, v, &lo, &hi);
+    if (!(lo <= hi)) continue;
+    const int col0 = std::max(0, static_cast<int>(std::floor(lo - 1)));
+    const int col1 =
+        std::min(raster.width - 1, static_cast<int>(std::ceil(hi + 1)));
+    if (col0 > col1) continue;
+    const float fv = static_cast<float>(v);
+    const RowTarget row{h(0, 1) * fv + h(0, 2), h(1, 1) * fv + h(1, 2),
+                        h(2, 1) * fv + h(2, 2),
+                        raster.zbuf + static_cast<size_t>(v) * raster.width,
+                        raster.image->ptr<uint8_t>(v)};
+    for (int s0 = col0; s0 <= col1; s0 += kSpan) {
+      const int s1 = std::min(col1, s0 + kSpan - 1);
+      const int level = MipLevel(proj.texel_from_pixel, s0, s1, v, num_levels,
+                                 raster.area_footprint, raster.mip_bias);
+      if (DrawSpan<C>(levels[level], level, h, row, s0, s1, raster)) {
+        drawn = true;
+      }
+    }
+  }
+  return drawn;
+}
+
+// Depth (metres, 0 for background) of rows [r_begin, r_end) from their
+// inverse depths, if depth is not null; returns their foreground pixels.
+int FillDepthRows(const float* zbuf, int width, int r_begin, int r_end,
+                  cv::Mat* depth) {
+  int foreground = 0;
+  for (int v = r_begin; v < r_end; ++v) {
+    const float* z = zbuf + static_cast<size_t>(v) * width;
+    float* d = depth != nullptr ? depth->ptr<float>(v) : nullptr;
+    for (int u = 0; u < width; ++u) {
+      const bool fg = z[u] > 0.f;
+      foreground += fg;
+      if (d != nullptr) d[u] = fg ? 1.f / z[u] : 0.f;
+    }
+  }
+  return foreground;
+}
+
+}  // namespace
+
+struct Renderer::PlaneView {
+  const PlaneData* plane;
+  PlaneProjection proj;
+};
+
+std::vector<Renderer::PlaneView> Renderer::ViewPlanes(
+    const Camera& camera, const Rigid3d& world_from_cam) const {
+  const Rigid3d cam_from_world = world_from_cam.Inverse();
+  const Eigen::Matrix3d rot = cam_from_world.RotationMatrix();
+  const Eigen::Vector3d trans = cam_from_world.translation;
+  const Eigen::Matrix3d k = camera.K();
+  std::vector<PlaneView> views;
+  views.reserve(planes_.size());
+  for (const auto& plane : planes_) {
+    PlaneProjection proj;
+    if (ProjectPlane(plane->frame, plane->pixels_per_meter, plane->st_min,
+                     plane->st_max, rot, trans, camera, k, options_, &proj)) {
+      views.push_back({plane.get(), proj});
+    }
+  }
+  return views;
+}
+
 template <int C>
 RenderStats Renderer::RenderImpl(const Camera& camera,
-                                 const Rigid3d& world_from_cam,
-                                 cv::Mat* image, cv::Mat* depth) const {
-  constexpr int kOut = C == 2 ? 1 : 3;
+                                 const Rigid3d& world_from_cam, cv::Mat* image,
+                                 cv::Mat* depth) const {
   CheckOption(camera.width > 0 && camera.height > 0 && camera.fx > 0 &&
                   camera.fy > 0,
               "camera", "needs a positive size and focal lengths");
@@ -275,228 +539,37 @@ RenderStats Renderer::RenderImpl(const Camera& camera,
   const int height = camera.height;
   image->create(height, width, C == 2 ? CV_8UC1 : CV_8UC3);
   image->setTo(cv::Scalar::all(options_.background_grey));
-
+  if (depth != nullptr) depth->create(height, width, CV_32FC1);
   // Z-buffer of inverse depth; 0 = background (infinitely far). Kept per
   // thread so that renders do not allocate.
   thread_local std::vector<float> zbuffer;
   zbuffer.assign(static_cast<size_t>(width) * height, 0.f);
+  const Raster raster{width,
+                      zbuffer.data(),
+                      image,
+                      static_cast<float>(1.0 / options_.z_near_m),
+                      static_cast<float>(options_.alpha_threshold),
+                      options_.mip_bias,
+                      options_.mip_footprint == MipFootprint::kArea};
 
-  RenderStats stats;
-  stats.planes_in_map = num_planes();
-  stats.pixels_total = width * height;
-
-  const Rigid3d cam_from_world = world_from_cam.Inverse();
-  const Eigen::Matrix3d rot = cam_from_world.RotationMatrix();
-  const Eigen::Vector3d trans = cam_from_world.translation;
-  const Eigen::Matrix3d k = camera.K();
-  const float inv_near = static_cast<float>(1.0 / options_.z_near_m);
-  const float alpha_min = static_cast<float>(options_.alpha_threshold);
-
-  // Pass 1: which planes face the camera, their pixel-to-texel homography
-  // and the image polygon of the region to scan.
-  struct PlaneView {
-    const PlaneData* plane;
-    Eigen::Matrix3d texel_from_pixel;
-    std::array<Eigen::Vector2d, 8> poly;
-    int n;           // vertices of poly
-    int row0, row1;  // rows it may cover
-  };
-  std::vector<PlaneView> views;
-  views.reserve(planes_.size());
-  for (const auto& plane_ptr : planes_) {
-    const PlaneData& plane = *plane_ptr;
-    const double ppm = plane.pixels_per_meter;
-    const Eigen::Vector3d u_c = rot * plane.frame.u_axis;
-    const Eigen::Vector3d v_c = rot * plane.frame.v_axis;
-    const Eigen::Vector3d o_c = rot * plane.frame.origin + trans;
-    // Camera centre on the normal's side <=> n . (0 - o) > 0.
-    const double side = -u_c.cross(v_c).dot(o_c);
-    if (options_.cull_back_faces ? side <= 1e-12 : std::abs(side) <= 1e-12) {
-      continue;
-    }
-
-    // pixel_from_texel = K [R u, R v, R o + t] with texel centres at
-    // (c + 0.5) / ppm. Its inverse maps pixels to homogeneous texels whose
-    // third coordinate is exactly 1/z.
-    Eigen::Matrix3d m;
-    m.col(0) = u_c / ppm;
-    m.col(1) = v_c / ppm;
-    m.col(2) = o_c + 0.5 * (u_c + v_c) / ppm;
-    const Eigen::Matrix3d texel_from_pixel = (k * m).inverse();
-    if (!texel_from_pixel.allFinite()) continue;
-
-    // The scanned region, clipped to the near plane and projected: a
-    // convex polygon, whose extent per row bounds the pixels to visit.
-    const std::array<Eigen::Vector3d, 4> corners = {
-        o_c + plane.st_min.x() * u_c + plane.st_min.y() * v_c,
-        o_c + plane.st_max.x() * u_c + plane.st_min.y() * v_c,
-        o_c + plane.st_max.x() * u_c + plane.st_max.y() * v_c,
-        o_c + plane.st_min.x() * u_c + plane.st_max.y() * v_c};
-    std::array<Eigen::Vector3d, 8> clipped;
-    const int n = ClipNear(corners, options_.z_near_m, &clipped);
-    if (n < 3) continue;
-    std::array<Eigen::Vector2d, 8> poly;
-    double vmin = std::numeric_limits<double>::infinity();
-    double vmax = -vmin, umin_all = vmin, umax_all = -vmin;
-    for (int i = 0; i < n; ++i) {
-      const Eigen::Vector3d& x = clipped[i];
-      poly[i] = {camera.fx * x.x() / x.z() + camera.cx,
-                 camera.fy * x.y() / x.z() + camera.cy};
-      vmin = std::min(vmin, poly[i].y());
-      vmax = std::max(vmax, poly[i].y());
-      umin_all = std::min(umin_all, poly[i].x());
-      umax_all = std::max(umax_all, poly[i].x());
-    }
-    if (vmax < -1 || vmin > height || umax_all < -1 || umin_all > width) {
-      continue;
-    }
-    const int row0 = std::max(0, static_cast<int>(std::floor(vmin - 1)));
-    const int row1 =
-        std::min(height - 1, static_cast<int>(std::ceil(vmax + 1)));
-
-    views.push_back({&plane, texel_from_pixel, poly, n, row0, row1});
-  }
-
-  // Pass 2: rows [r_begin, r_end) of every plane in map order, so that a
-  // band of rows is independent of the others and the result does not
-  // depend on how the rows are split.
-  const double bias = options_.mip_bias;
-  const bool area_footprint = options_.mip_footprint == MipFootprint::kArea;
+  // Pass 1: the planes facing the camera. Pass 2: rows [r_begin, r_end) of
+  // every plane in map order, so that a band of rows is independent of the
+  // others and the result does not depend on how the rows are split.
+  const std::vector<PlaneView> views = ViewPlanes(camera, world_from_cam);
   std::vector<std::atomic<bool>> drawn(views.size());
-  float* const zbuf = zbuffer.data();
   std::atomic<int> pixels_foreground{0};
-  if (depth != nullptr) depth->create(height, width, CV_32FC1);
   auto draw_rows = [&](int r_begin, int r_end) {
     for (size_t pi = 0; pi < views.size(); ++pi) {
       const PlaneView& view = views[pi];
-      const std::vector<Level>& levels = view.plane->template levels<C>();
-      const Eigen::Matrix3d& texel_from_pixel = view.texel_from_pixel;
-      const std::array<Eigen::Vector2d, 8>& poly = view.poly;
-      const int n = view.n;
-      const int row0 = std::max(view.row0, r_begin);
-      const int row1 = std::min(view.row1, r_end - 1);
-      const Eigen::Matrix3f h = texel_from_pixel.cast<float>();
-      const int num_levels = static_cast<int>(levels.size());
-      bool plane_drawn = false;
-
-      for (int v = row0; v <= row1; ++v) {
-        // Extent of the polygon within the band [v - 1, v + 1].
-        const double b0 = v - 1.0, b1 = v + 1.0;
-        double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-        for (int i = 0; i < n; ++i) {
-          const Eigen::Vector2d& p = poly[i];
-          const Eigen::Vector2d& q = poly[(i + 1) % n];
-          if (p.y() >= b0 && p.y() <= b1) {
-            lo = std::min(lo, p.x());
-            hi = std::max(hi, p.x());
-          }
-          for (double b : {b0, b1}) {
-            if ((p.y() - b) * (q.y() - b) < 0) {
-              const double x =
-                  p.x() + (b - p.y()) / (q.y() - p.y()) * (q.x() - p.x());
-              lo = std::min(lo, x);
-              hi = std::max(hi, x);
-            }
-          }
-        }
-        if (!(lo <= hi)) continue;
-        const int col0 = std::max(0, static_cast<int>(std::floor(lo - 1)));
-        const int col1 =
-            std::min(width - 1, static_cast<int>(std::ceil(hi + 1)));
-        if (col0 > col1) continue;
-
-        const float fv = static_cast<float>(v);
-        const float x_row = h(0, 1) * fv + h(0, 2);
-        const float y_row = h(1, 1) * fv + h(1, 2);
-        const float w_row = h(2, 1) * fv + h(2, 2);
-        float* zrow = zbuf + static_cast<size_t>(v) * width;
-        uint8_t* out = image->ptr<uint8_t>(v);
-
-        for (int s0 = col0; s0 <= col1; s0 += kSpan) {
-          const int s1 = std::min(col1, s0 + kSpan - 1);
-          // Mip level from the texel footprint at the span's centre: rho^2 =
-          // |det d texel / d pixel| (area) or the squared longest of its
-          // columns; level = round(log2 rho).
-          int level = 0;
-          if (num_levels > 1) {
-            const double uc = 0.5 * (s0 + s1);
-            const Eigen::Vector3d t =
-                texel_from_pixel * Eigen::Vector3d(uc, v, 1);
-            if (t.z() > 0) {
-              const double x = t.x() / t.z(), y = t.y() / t.z();
-              const Eigen::Matrix3d& hd = texel_from_pixel;
-              const double dxdu = (hd(0, 0) - x * hd(2, 0)) / t.z();
-              const double dydu = (hd(1, 0) - y * hd(2, 0)) / t.z();
-              const double dxdv = (hd(0, 1) - x * hd(2, 1)) / t.z();
-              const double dydv = (hd(1, 1) - y * hd(2, 1)) / t.z();
-              const double rho2 = area_footprint
-                                      ? std::abs(dxdu * dydv - dydu * dxdv)
-                                      : std::max(dxdu * dxdu + dydu * dydu,
-                                                 dxdv * dxdv + dydv * dydv);
-              const double lambda = 0.5 * std::log2(rho2) + bias;
-              if (lambda > 0.5) {
-                level = std::min(num_levels - 1,
-                                 static_cast<int>(std::floor(lambda + 0.5)));
-              }
-            }
-          }
-          const Level& lev = levels[level];
-          // Level-0 texel x -> padded level-L coordinate
-          // (x + 0.5) / 2^L - 0.5 + 1.
-          const float scale = std::ldexp(1.f, -level);
-          const float offset = 0.5f * scale + 0.5f;
-          const float x_max = static_cast<float>(lev.width + 1);
-          const float y_max = static_cast<float>(lev.height + 1);
-          const float* texels = lev.data.data();
-          const int stride = lev.stride;
-
-          for (int u = s0; u <= s1; ++u) {
-            const float fu = static_cast<float>(u);
-            const float w = w_row + h(2, 0) * fu;
-            // Nearest surface wins; 1/z <= 0 is behind the camera.
-            if (!(w > zrow[u]) || w > inv_near) continue;
-            const float inv_w = 1.f / w;
-            const float x = (x_row + h(0, 0) * fu) * inv_w * scale + offset;
-            const float y = (y_row + h(1, 0) * fu) * inv_w * scale + offset;
-            if (!(x >= 0.f && x < x_max && y >= 0.f && y < y_max)) continue;
-            const int xi = static_cast<int>(x);
-            const int yi = static_cast<int>(y);
-            const float fx = x - xi, fy = y - yi;
-            const float* p0 = texels + yi * stride + xi * C;
-            const float* p1 = p0 + stride;
-            float val[C];
-            for (int c = 0; c < C; ++c) {
-              const float top = p0[c] + fx * (p0[C + c] - p0[c]);
-              const float bottom = p1[c] + fx * (p1[C + c] - p1[c]);
-              val[c] = top + fy * (bottom - top);
-            }
-            const float alpha = val[C - 1];
-            if (alpha < alpha_min) continue;
-            const float inv_alpha = 1.f / alpha;
-            zrow[u] = w;
-            uint8_t* o = out + u * kOut;
-            for (int c = 0; c < kOut; ++c) {
-              o[c] = static_cast<uint8_t>(
-                  std::min(255.f, val[c] * inv_alpha + 0.5f));
-            }
-            plane_drawn = true;
-          }
-        }
-      }
-      if (plane_drawn) drawn[pi].store(true, std::memory_order_relaxed);
-    }
-    // Depth from the band's inverse depths.
-    int foreground = 0;
-    for (int v = r_begin; v < r_end; ++v) {
-      const float* z = zbuf + static_cast<size_t>(v) * width;
-      float* d = depth != nullptr ? depth->ptr<float>(v) : nullptr;
-      for (int u = 0; u < width; ++u) {
-        const bool fg = z[u] > 0.f;
-        foreground += fg;
-        if (d != nullptr) d[u] = fg ? 1.f / z[u] : 0.f;
+      if (DrawPlaneRows<C>(view.plane->template levels<C>(), view.proj,
+                           std::max(view.proj.row0, r_begin),
+                           std::min(view.proj.row1, r_end - 1), raster)) {
+        drawn[pi].store(true, std::memory_order_relaxed);
       }
     }
-    pixels_foreground.fetch_add(foreground, std::memory_order_relaxed);
+    pixels_foreground.fetch_add(
+        FillDepthRows(raster.zbuf, width, r_begin, r_end, depth),
+        std::memory_order_relaxed);
   };
   // One render is serial below kParallelPixels (renders that small are
   // parallel across poses instead: RenderBatch, the particle filter).
@@ -508,9 +581,11 @@ RenderStats Renderer::RenderImpl(const Camera& camera,
   } else {
     draw_rows(0, height);
   }
+  RenderStats stats;
+  stats.planes_in_map = num_planes();
+  stats.pixels_total = width * height;
   for (const std::atomic<bool>& d : drawn) stats.planes_drawn += d.load();
   stats.pixels_foreground = pixels_foreground.load();
-
   return stats;
 }
 

@@ -117,6 +117,10 @@ class Renderer {
 
  private:
   struct PlaneData;
+  struct PlaneView;  // a plane facing the camera, projected into its image
+  // Pass 1 of a render: the planes that face the camera and are in view.
+  std::vector<PlaneView> ViewPlanes(const Camera& camera,
+                                    const Rigid3d& world_from_cam) const;
   template <int C>
   RenderStats RenderImpl(const Camera& camera, const Rigid3d& world_from_cam,
                          cv::Mat* image, cv::Mat* depth) const;

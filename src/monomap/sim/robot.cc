@@ -4,6 +4,7 @@
 #include <cmath>
 #include <opencv2/core.hpp>
 
+#include "monomap/util/angles.h"
 #include "monomap/util/error.h"
 
 namespace monomap {
@@ -41,11 +42,11 @@ Rigid3d MakeCameraMount(const CameraMountOptions& options) {
   level.col(2) = Eigen::Vector3d::UnitX();
   // Tilting down turns z towards +y of the camera: rotate about camera x.
   const Eigen::Matrix3d tilt =
-      Eigen::AngleAxisd(-options.tilt_down_deg * M_PI / 180.0,
+      Eigen::AngleAxisd(DegToRadMulDiv(-options.tilt_down_deg),
                         Eigen::Vector3d::UnitX())
           .toRotationMatrix();
   const Eigen::Matrix3d yaw =
-      Eigen::AngleAxisd(options.yaw_left_deg * M_PI / 180.0,
+      Eigen::AngleAxisd(DegToRadMulDiv(options.yaw_left_deg),
                         Eigen::Vector3d::UnitZ())
           .toRotationMatrix();
   return Rigid3d(Eigen::Quaterniond(yaw * level * tilt),

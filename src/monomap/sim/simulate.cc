@@ -9,6 +9,7 @@
 #include "monomap/io/dataset.h"
 #include "monomap/io/map_format.h"
 #include "monomap/io/trajectory_io.h"
+#include "monomap/util/angles.h"
 #include "monomap/util/error.h"
 #include "monomap/util/file.h"
 #include "monomap/util/progress.h"
@@ -106,7 +107,7 @@ void FillPathReport(const World& world, const std::vector<TimedPose2d>& truth,
           ? 100.0 * report->final_drift_m / report->path_length_m
           : 0.0;
   report->final_yaw_error_deg =
-      std::abs(std::remainder(a.yaw - b.yaw, 2.0 * M_PI)) * 180.0 / M_PI;
+      RadToDegMulDiv(std::abs(std::remainder(a.yaw - b.yaw, 2.0 * M_PI)));
 }
 
 // Adds the (hidden) moving disc and its frame span to the report; returns

@@ -1,7 +1,8 @@
 // Synthetic track/pose scenes with known truth, for the triangulation and
 // evaluation tests and benchmarks: a camera sliding sideways in front of
 // random points, KLT-like tracks of raw distorted pixels, and odometry with
-// a realistic drift. (Textured-plane scenes: textured_plane_scene.h.)
+// a realistic drift. (Textured-plane scenes: textured_plane_scene.h; the
+// localization room: room_scene.h.)
 #pragma once
 
 #include <cstdint>

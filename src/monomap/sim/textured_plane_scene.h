@@ -1,7 +1,8 @@
 // Synthetic textured-plane scenes for the texture tests and benchmark: an
 // exact per-pixel ray caster through a distorted camera, procedural plane
 // textures and feature tracks. Header-only; not part of the library API.
-// (Point-track scenes: synthetic_scene.h.)
+// (Point-track scenes: synthetic_scene.h; the localization room:
+// room_scene.h.)
 #pragma once
 
 #include <cmath>

@@ -124,25 +124,15 @@ double HomographyPixelsPerMeter(const Eigen::Matrix3d& h,
   return std::sqrt(std::abs(j.determinant()));
 }
 
-HomographyReport ComputeImagePlaneHomographies(
-    const Camera& camera, const std::vector<Rigid3d>& world_from_cam,
-    const std::vector<PlaneSegment>& segments,
-    const std::vector<Landmark>& landmarks, const std::vector<Track>& tracks,
-    const HomographyOptions& options,
-    std::vector<ImagePlaneHomography>* homographies) {
-  options.Check();
-  camera.Check();
-  Timer timer;
-  HomographyReport report;
-  homographies->clear();
-  const int num_frames = static_cast<int>(world_from_cam.size());
-  const int num_planes = static_cast<int>(segments.size());
-  if (num_frames == 0 || num_planes == 0) {
-    report.seconds = timer.ElapsedSeconds();
-    return report;
-  }
+namespace {
 
-  // Feature sightings per (frame, plane).
+// Feature sightings per (frame, plane), at frame * num_planes + plane; a
+// plane's features in id order (deterministic).
+std::vector<std::vector<FeatureSighting>> SightingsByFramePlane(
+    const Camera& camera, int num_frames,
+    const std::vector<PlaneSegment>& segments,
+    const std::vector<Landmark>& landmarks, const std::vector<Track>& tracks) {
+  const int num_planes = static_cast<int>(segments.size());
   std::unordered_map<FeatureId, const Track*> track_by_id;
   for (const auto& t : tracks) track_by_id[t.id] = &t;
   std::unordered_map<FeatureId, const Landmark*> landmark_by_id;
@@ -171,7 +161,179 @@ HomographyReport ComputeImagePlaneHomographies(
       }
     }
   }
+  return sightings;
+}
 
+// What every (frame, plane) pair shares.
+struct HomographyContext {
+  const Camera& camera;
+  const DistortedProjector& projector;
+  const Eigen::Matrix3d k;
+  const HomographyOptions& options;
+};
+
+// Samples of the plane (plane coordinates) that project into the image.
+int VisibleSamples(const HomographyContext& ctx, const Rigid3d& cam_from_world,
+                   const PlaneFrame& frame,
+                   const std::vector<Eigen::Vector2d>& samples) {
+  int visible = 0;
+  for (const auto& st : samples) {
+    Eigen::Vector2d px;
+    if (ctx.projector.Project(cam_from_world * frame.ToWorld(st), &px) &&
+        ctx.camera.InImage(px)) {
+      ++visible;
+    }
+  }
+  return visible;
+}
+
+// pixel_from_plane corrected by a homography from its predicted to the
+// observed pixels (both in pixels, so the estimate is well conditioned),
+// signed so that the plane centre is in front. False if RANSAC found none.
+bool CorrectedHomography(const Eigen::Matrix3d& pixel_from_plane,
+                         const std::vector<FeatureSighting>& feats,
+                         const Eigen::Vector2d& centre,
+                         const HomographyOptions& options, Eigen::Matrix3d* h) {
+  std::vector<cv::Point2f> predicted, observed;
+  for (const auto& s : feats) {
+    const Eigen::Vector3d y = pixel_from_plane * s.st.homogeneous();
+    if (y.z() <= 0) continue;
+    const Eigen::Vector2d q = y.hnormalized();
+    predicted.emplace_back(static_cast<float>(q.x()),
+                           static_cast<float>(q.y()));
+    observed.emplace_back(static_cast<float>(s.px.x()),
+                          static_cast<float>(s.px.y()));
+  }
+  cv::Mat c_cv;
+  if (static_cast<int>(predicted.size()) >= options.min_features_to_refine) {
+    c_cv = cv::findHomography(predicted, observed, cv::RANSAC,
+                              options.ransac_threshold_px);
+  }
+  if (c_cv.empty()) return false;
+  Eigen::Matrix3d c;
+  cv::cv2eigen(c_cv, c);
+  *h = c * pixel_from_plane;
+  if ((*h * centre.homogeneous()).z() < 0) *h = -*h;
+  return true;
+}
+
+// Whether h keeps every imaged polygon corner in front of the camera and
+// within max_shift_px of where pixel_from_plane puts it.
+bool CornersStay(const Eigen::Matrix3d& pixel_from_plane,
+                 const Eigen::Matrix3d& h, const Polygon2d& polygon,
+                 double max_shift_px) {
+  for (const auto& v : polygon) {
+    const Eigen::Vector3d y0 = pixel_from_plane * v.homogeneous();
+    const Eigen::Vector3d y1 = h * v.homogeneous();
+    if (y0.z() <= 0) continue;  // behind the camera: not imaged
+    if (y1.z() <= 0 ||
+        (y1.hnormalized() - y0.hnormalized()).norm() > max_shift_px) {
+      return false;
+    }
+  }
+  return true;
+}
+
+// Replaces hp's homography by the feature-corrected one if that keeps the
+// corners and lowers the median residual.
+void RefineHomography(const std::vector<FeatureSighting>& feats,
+                      const PlaneSegment& seg, const Eigen::Vector2d& centre,
+                      const HomographyOptions& options,
+                      ImagePlaneHomography* hp) {
+  Eigen::Matrix3d h;
+  if (!CorrectedHomography(hp->pixel_from_plane, feats, centre, options, &h) ||
+      !CornersStay(hp->pixel_from_plane, h, seg.polygon,
+                   options.max_corner_shift_px)) {
+    return;
+  }
+  const ResidualStats after = Residuals(h, feats);
+  if (after.median < hp->before.median) {
+    hp->pixel_from_plane = h;
+    hp->after = after;
+    hp->refined = true;
+  }
+}
+
+// The homography of plane seg in frame f, refined if its features disagree
+// (*attempted tells whether a refinement was tried). False if too little
+// of the plane is visible.
+bool FramePlaneHomography(const HomographyContext& ctx, int f,
+                          const Rigid3d& cam_from_world,
+                          const PlaneSegment& seg,
+                          const std::vector<Eigen::Vector2d>& samples,
+                          const Eigen::Vector2d& centre,
+                          const std::vector<FeatureSighting>& sightings,
+                          ImagePlaneHomography* hp, bool* attempted) {
+  const HomographyOptions& options = ctx.options;
+  const int visible = VisibleSamples(ctx, cam_from_world, seg.frame, samples);
+  const double fraction = static_cast<double>(visible) / samples.size();
+  if (visible == 0 || fraction < options.min_visible_fraction) return false;
+  hp->frame = f;
+  hp->plane_id = seg.id;
+  hp->visible_fraction = fraction;
+  hp->pixel_from_plane =
+      ctx.k * NormalizedImageFromPlane(cam_from_world, seg.frame);
+  const std::vector<FeatureSighting> feats =
+      OnPlaneSightings(sightings, ctx.k, cam_from_world, hp->pixel_from_plane,
+                       options.max_feature_parallax_px);
+  hp->num_features = static_cast<int>(feats.size());
+  hp->before = Residuals(hp->pixel_from_plane, feats);
+  hp->after = hp->before;
+  *attempted = options.refine &&
+               hp->num_features >= options.min_features_to_refine &&
+               hp->before.median > options.refine_threshold_px;
+  if (*attempted) RefineHomography(feats, seg, centre, options, hp);
+  hp->residual_before_px = hp->before.median;
+  hp->residual_after_px = hp->after.median;
+  hp->pixels_per_meter = HomographyPixelsPerMeter(hp->pixel_from_plane, centre);
+  return true;
+}
+
+// Concatenates the frames' homographies and counts them into the report.
+void CollectHomographies(
+    const std::vector<std::vector<ImagePlaneHomography>>& per_frame,
+    const std::vector<int>& attempted,
+    std::vector<ImagePlaneHomography>* homographies, HomographyReport* report) {
+  std::vector<double> before, after;
+  for (size_t f = 0; f < per_frame.size(); ++f) {
+    for (const auto& hp : per_frame[f]) {
+      if (hp.num_features > 0) {
+        ++report->num_checked;
+        before.push_back(hp.residual_before_px);
+        after.push_back(hp.residual_after_px);
+      }
+      if (hp.refined) ++report->num_refined;
+      homographies->push_back(hp);
+    }
+    report->num_refinement_rejected += attempted[f];
+  }
+  report->num_refinement_rejected -= report->num_refined;
+  report->num_homographies = static_cast<int>(homographies->size());
+  report->median_residual_before_px = Median(before);
+  report->median_residual_after_px = Median(after);
+}
+
+}  // namespace
+
+HomographyReport ComputeImagePlaneHomographies(
+    const Camera& camera, const std::vector<Rigid3d>& world_from_cam,
+    const std::vector<PlaneSegment>& segments,
+    const std::vector<Landmark>& landmarks, const std::vector<Track>& tracks,
+    const HomographyOptions& options,
+    std::vector<ImagePlaneHomography>* homographies) {
+  options.Check();
+  camera.Check();
+  Timer timer;
+  HomographyReport report;
+  homographies->clear();
+  const int num_frames = static_cast<int>(world_from_cam.size());
+  const int num_planes = static_cast<int>(segments.size());
+  if (num_frames == 0 || num_planes == 0) {
+    report.seconds = timer.ElapsedSeconds();
+    return report;
+  }
+  const std::vector<std::vector<FeatureSighting>> sightings =
+      SightingsByFramePlane(camera, num_frames, segments, landmarks, tracks);
   std::vector<std::vector<Eigen::Vector2d>> samples(num_planes);
   std::vector<Eigen::Vector2d> centres(num_planes);
   for (int p = 0; p < num_planes; ++p) {
@@ -183,108 +345,25 @@ HomographyReport ComputeImagePlaneHomographies(
   }
 
   const DistortedProjector projector(camera, options.min_depth_m);
-  const Eigen::Matrix3d k = camera.K();
+  const HomographyContext ctx{camera, projector, camera.K(), options};
   std::vector<std::vector<ImagePlaneHomography>> per_frame(num_frames);
   std::vector<int> attempted(num_frames, 0);
   tbb::parallel_for(0, num_frames, [&](int f) {
     const Rigid3d cam_from_world = world_from_cam[f].Inverse();
     for (int p = 0; p < num_planes; ++p) {
-      const PlaneSegment& seg = segments[p];
       if (samples[p].empty()) continue;
-      int visible = 0;
-      for (const auto& st : samples[p]) {
-        Eigen::Vector2d px;
-        if (projector.Project(cam_from_world * seg.frame.ToWorld(st), &px) &&
-            camera.InImage(px)) {
-          ++visible;
-        }
-      }
-      const double fraction =
-          static_cast<double>(visible) / samples[p].size();
-      if (visible == 0 || fraction < options.min_visible_fraction) continue;
-
       ImagePlaneHomography hp;
-      hp.frame = f;
-      hp.plane_id = seg.id;
-      hp.visible_fraction = fraction;
-      hp.pixel_from_plane = k * NormalizedImageFromPlane(cam_from_world,
-                                                         seg.frame);
-      const std::vector<FeatureSighting> feats = OnPlaneSightings(
-          sightings[static_cast<size_t>(f) * num_planes + p], k,
-          cam_from_world, hp.pixel_from_plane, options.max_feature_parallax_px);
-      hp.num_features = static_cast<int>(feats.size());
-      hp.before = Residuals(hp.pixel_from_plane, feats);
-      hp.after = hp.before;
-      if (options.refine && hp.num_features >= options.min_features_to_refine &&
-          hp.before.median > options.refine_threshold_px) {
-        ++attempted[f];
-        // Correction homography from predicted to observed pixels: both in
-        // pixels, so the estimate is well conditioned.
-        std::vector<cv::Point2f> predicted, observed;
-        for (const auto& s : feats) {
-          const Eigen::Vector3d y = hp.pixel_from_plane * s.st.homogeneous();
-          if (y.z() <= 0) continue;
-          const Eigen::Vector2d q = y.hnormalized();
-          predicted.emplace_back(static_cast<float>(q.x()),
-                                 static_cast<float>(q.y()));
-          observed.emplace_back(static_cast<float>(s.px.x()),
-                                static_cast<float>(s.px.y()));
-        }
-        cv::Mat c_cv;
-        if (static_cast<int>(predicted.size()) >=
-            options.min_features_to_refine) {
-          c_cv = cv::findHomography(predicted, observed, cv::RANSAC,
-                                    options.ransac_threshold_px);
-        }
-        if (!c_cv.empty()) {
-          Eigen::Matrix3d c;
-          cv::cv2eigen(c_cv, c);
-          Eigen::Matrix3d h = c * hp.pixel_from_plane;
-          if ((h * centres[p].homogeneous()).z() < 0) h = -h;
-          bool corners_ok = true;
-          for (const auto& v : seg.polygon) {
-            const Eigen::Vector3d y0 = hp.pixel_from_plane * v.homogeneous();
-            const Eigen::Vector3d y1 = h * v.homogeneous();
-            if (y0.z() <= 0) continue;  // behind the camera: not imaged
-            if (y1.z() <= 0 || (y1.hnormalized() - y0.hnormalized()).norm() >
-                                   options.max_corner_shift_px) {
-              corners_ok = false;
-              break;
-            }
-          }
-          const ResidualStats after = Residuals(h, feats);
-          if (corners_ok && after.median < hp.before.median) {
-            hp.pixel_from_plane = h;
-            hp.after = after;
-            hp.refined = true;
-          }
-        }
+      bool tried = false;
+      if (FramePlaneHomography(
+              ctx, f, cam_from_world, segments[p], samples[p], centres[p],
+              sightings[static_cast<size_t>(f) * num_planes + p], &hp,
+              &tried)) {
+        attempted[f] += tried;
+        per_frame[f].push_back(hp);
       }
-      hp.residual_before_px = hp.before.median;
-      hp.residual_after_px = hp.after.median;
-      hp.pixels_per_meter =
-          HomographyPixelsPerMeter(hp.pixel_from_plane, centres[p]);
-      per_frame[f].push_back(hp);
     }
   });
-
-  std::vector<double> before, after;
-  for (int f = 0; f < num_frames; ++f) {
-    for (auto& hp : per_frame[f]) {
-      if (hp.num_features > 0) {
-        ++report.num_checked;
-        before.push_back(hp.residual_before_px);
-        after.push_back(hp.residual_after_px);
-      }
-      if (hp.refined) ++report.num_refined;
-      homographies->push_back(hp);
-    }
-    report.num_refinement_rejected += attempted[f];
-  }
-  report.num_refinement_rejected -= report.num_refined;
-  report.num_homographies = static_cast<int>(homographies->size());
-  report.median_residual_before_px = Median(before);
-  report.median_residual_after_px = Median(after);
+  CollectHomographies(per_frame, attempted, homographies, &report);
   report.seconds = timer.ElapsedSeconds();
   return report;
 }

@@ -124,13 +124,88 @@ bool FeatureTemplate::Extract(const cv::Mat& grey,
   return true;
 }
 
+namespace {
+
+// Resamples the image under the warp (A, t) over [-r, r]^2 into samples,
+// row by row (the offsets of a row advance by A's first column); sets their
+// mean and variance. The warp must lie where Sample() may read.
+void SampleWarpedPatch(const cv::Mat& grey, const Eigen::Matrix2f& a,
+                       const Eigen::Vector2f& t, int r,
+                       std::vector<float>* samples, double* mean, double* var) {
+  double sum = 0.0, sum2 = 0.0;
+  size_t k = 0;
+  for (int y = -r; y <= r; ++y) {
+    Eigen::Vector2f p = a * Eigen::Vector2f(-r, y) + t;
+    const Eigen::Vector2f step = a.col(0);
+    for (int x = -r; x <= r; ++x, ++k, p += step) {
+      const float v = Sample(grey, p.x(), p.y());
+      (*samples)[k] = v;
+      sum += v;
+      sum2 += static_cast<double>(v) * v;
+    }
+  }
+  const size_t n = samples->size();
+  *mean = sum / n;
+  *var = sum2 / n - *mean * *mean;
+}
+
+// Gauss-Newton right-hand side b = J^T e of the normalized samples against
+// the template (values, jacobian: 6 per value); returns sum e^2.
+double TemplateResidual(const std::vector<float>& samples, double mean,
+                        double var, const std::vector<float>& values,
+                        const std::vector<float>& jacobian,
+                        Eigen::Matrix<double, 6, 1>* b) {
+  const float inv_sigma = static_cast<float>(1.0 / std::sqrt(var));
+  const float fmean = static_cast<float>(mean);
+  float b_f[6] = {0, 0, 0, 0, 0, 0};
+  double sq = 0.0;
+  for (size_t i = 0; i < values.size(); ++i) {
+    const float e = (samples[i] - fmean) * inv_sigma - values[i];
+    sq += static_cast<double>(e) * e;
+    const float* j = &jacobian[6 * i];
+    for (int q = 0; q < 6; ++q) b_f[q] += j[q] * e;
+  }
+  for (int q = 0; q < 6; ++q) (*b)(q) = b_f[q];
+  return sq;
+}
+
+// Inverse compositional update of the warp (A, t): W <- W o W(dp)^-1.
+// False if W(dp) is (nearly) singular.
+bool ComposeInverse(const Eigen::Matrix<double, 6, 1>& dp, Eigen::Matrix2f* a,
+                    Eigen::Vector2f* t) {
+  Eigen::Matrix2d d;
+  d << 1.0 + dp(0), dp(1), dp(2), 1.0 + dp(3);
+  if (std::abs(d.determinant()) < 1e-6) return false;
+  const Eigen::Matrix2d d_inv = d.inverse();
+  const Eigen::Matrix2f a_new = (a->cast<double>() * d_inv).cast<float>();
+  const Eigen::Vector2f t_new =
+      *t - (a->cast<double>() * d_inv * dp.tail<2>()).cast<float>();
+  *a = a_new;
+  *t = t_new;
+  return true;
+}
+
+// A warp that did not settle, folded or shrank/grew wildly, matches
+// poorly, or ran far from the frame-to-frame position t0 has locked onto
+// something else.
+bool LockedElsewhere(const Eigen::Matrix2f& a, const Eigen::Vector2f& t,
+                     const Eigen::Vector2f& t0, bool converged, double ncc,
+                     const AffineRefinementOptions& options) {
+  const Eigen::JacobiSVD<Eigen::Matrix2f> svd(a);
+  const float s_max = svd.singularValues()(0), s_min = svd.singularValues()(1);
+  return !converged || a.determinant() <= 0.0f || s_min < 0.5f ||
+         s_max > 2.0f || ncc < options.min_ncc ||
+         (t - t0).norm() > options.max_correction_px;
+}
+
+}  // namespace
+
 AffineRefinement FeatureTemplate::Refine(
     const cv::Mat& grey, Eigen::Matrix2f* a_io, Eigen::Vector2f* t_io,
     const AffineRefinementOptions& options) const {
   AffineRefinement result;
   if (values_.empty()) return result;
-  const int w = window_;
-  const int r = w / 2;
+  const int r = window_ / 2;
   const size_t n = values_.size();
   Eigen::Matrix2f a = *a_io;
   Eigen::Vector2f t = *t_io;
@@ -139,52 +214,21 @@ AffineRefinement FeatureTemplate::Refine(
   float last_step = std::numeric_limits<float>::infinity();
   for (int it = 0; it < options.max_iterations; ++it) {
     if (!WarpInside(grey, a, t, static_cast<float>(r))) return result;
-    // Resample the image under the current warp, row by row: the offsets
-    // of a row advance by A's first column.
-    double sum = 0.0, sum2 = 0.0;
-    size_t k = 0;
-    for (int y = -r; y <= r; ++y) {
-      Eigen::Vector2f p = a * Eigen::Vector2f(-r, y) + t;
-      const Eigen::Vector2f step = a.col(0);
-      for (int x = -r; x <= r; ++x, ++k, p += step) {
-        const float v = Sample(grey, p.x(), p.y());
-        samples[k] = v;
-        sum += v;
-        sum2 += static_cast<double>(v) * v;
-      }
-    }
-    const double mean = sum / n;
-    const double var = sum2 / n - mean * mean;
+    double mean, var;
+    SampleWarpedPatch(grey, a, t, r, &samples, &mean, &var);
     if (!(var > 1e-6)) return result;
-    const float inv_sigma = static_cast<float>(1.0 / std::sqrt(var));
-    const float fmean = static_cast<float>(mean);
-    Eigen::Matrix<double, 6, 1> b = Eigen::Matrix<double, 6, 1>::Zero();
-    float b_f[6] = {0, 0, 0, 0, 0, 0};
-    double sq = 0.0;
-    for (size_t i = 0; i < n; ++i) {
-      const float e = (samples[i] - fmean) * inv_sigma - values_[i];
-      sq += static_cast<double>(e) * e;
-      const float* j = &jacobian_[6 * i];
-      for (int q = 0; q < 6; ++q) b_f[q] += j[q] * e;
-    }
-    for (int q = 0; q < 6; ++q) b(q) = b_f[q];
+    Eigen::Matrix<double, 6, 1> b;
+    const double sq =
+        TemplateResidual(samples, mean, var, values_, jacobian_, &b);
     // Both patches have unit variance: mean squared difference = 2 - 2 NCC.
     last_ncc = 1.0 - 0.5 * sq / n;
     result.iterations = it + 1;
     const Eigen::Matrix<double, 6, 1> dp = hessian_inverse_ * b;
-    // Inverse compositional update: W <- W o W(dp)^-1.
-    Eigen::Matrix2d d;
-    d << 1.0 + dp(0), dp(1), dp(2), 1.0 + dp(3);
-    if (std::abs(d.determinant()) < 1e-6) return result;
-    const Eigen::Matrix2d d_inv = d.inverse();
-    const Eigen::Matrix2f a_new = (a.cast<double>() * d_inv).cast<float>();
-    const Eigen::Vector2f t_new =
-        t - (a.cast<double>() * d_inv * dp.tail<2>()).cast<float>();
+    const Eigen::Vector2f t_before = t;
+    if (!ComposeInverse(dp, &a, &t)) return result;
     // Converged when the feature point (the patch centre) settles; the
     // patch corners may still wobble by a few hundredths of a pixel.
-    const float moved = (t_new - t).norm();
-    a = a_new;
-    t = t_new;
+    const float moved = (t - t_before).norm();
     if (!a.allFinite() || !t.allFinite()) return result;
     last_step = moved;
     if (moved < options.epsilon_px) break;
@@ -193,13 +237,7 @@ AffineRefinement FeatureTemplate::Refine(
   // epsilons of the feature point is as good as settled.
   const bool converged = last_step < 5.0f * options.epsilon_px;
   result.ncc = last_ncc;
-  // A warp that did not settle, folded or shrank/grew wildly, or ran far
-  // from the frame-to-frame position has locked onto something else.
-  const Eigen::JacobiSVD<Eigen::Matrix2f> svd(a);
-  const float s_max = svd.singularValues()(0), s_min = svd.singularValues()(1);
-  if (!converged || a.determinant() <= 0.0f || s_min < 0.5f || s_max > 2.0f ||
-      last_ncc < options.min_ncc ||
-      (t - *t_io).norm() > options.max_correction_px) {
+  if (LockedElsewhere(a, t, *t_io, converged, last_ncc, options)) {
     return result;
   }
   result.accepted = true;

@@ -92,123 +92,14 @@ void KltTracker::Track(int frame_index, const cv::Mat& grey) {
 
 void KltTracker::Track(int frame_index, const cv::Mat& grey,
                        std::vector<cv::Mat> pyramid) {
-  const std::string where = "frame " + std::to_string(frame_index);
-  if (grey.empty() || grey.type() != CV_8UC1) {
-    throw InputError(where + ": tracking needs a non-empty 8-bit grey image");
-  }
-  if (last_frame_ >= 0 && frame_index <= last_frame_) {
-    throw InputError(where + ": frame indices must increase (previous " +
-                     std::to_string(last_frame_) + ")");
-  }
-  if (last_frame_ >= 0 && grey.size() != size_) {
-    throw InputError(where + ": image size " + std::to_string(grey.cols) + "x" +
-                     std::to_string(grey.rows) +
-                     " differs from the first frame's");
-  }
-  if (pyramid.empty()) throw InputError(where + ": empty image pyramid");
+  CheckFrame(frame_index, grey, pyramid);
   size_ = grey.size();
 
   KltFrameStats stats;
   stats.frame = frame_index;
-
   if (last_frame_ >= 0 && !active_.empty()) {
-    std::vector<cv::Point2f> prev_pts(active_.size());
-    for (size_t i = 0; i < active_.size(); ++i) prev_pts[i] = active_[i].px;
-
-    std::vector<cv::Point2f> next_pts;
-    std::vector<uchar> status;
-    std::vector<float> error;
-    PyramidalLk(prev_pyramid_, pyramid, prev_pts, &next_pts, &status, &error,
-                LkOptions(options_));
-
-    // Backward only for the features that survived the forward track.
-    std::vector<size_t> forward_ok;
-    std::vector<cv::Point2f> fwd_pts;
-    for (size_t i = 0; i < active_.size(); ++i) {
-      if (!status[i]) {
-        ++stats.lost_lk;
-      } else if (options_.max_lk_error > 0.0 &&
-                 error[i] > options_.max_lk_error) {
-        ++stats.lost_error;
-      } else {
-        forward_ok.push_back(i);
-        fwd_pts.push_back(next_pts[i]);
-      }
-    }
-    std::vector<cv::Point2f> back_pts;
-    std::vector<uchar> back_status;
-    std::vector<float> back_error;
-    if (!fwd_pts.empty()) {
-      // No initial guess at the original position: starting there would
-      // pull the backward track home even from content that changed.
-      PyramidalLk(pyramid, prev_pyramid_, fwd_pts, &back_pts, &back_status,
-                  &back_error, LkOptions(options_));
-    }
-
-    const double margin = options_.border_margin_px;
-    const double max_x = size_.width - 1 - margin;
-    const double max_y = size_.height - 1 - margin;
-    const double fb2 = options_.forward_backward_threshold_px *
-                       options_.forward_backward_threshold_px;
-    std::vector<Active> kept;
-    kept.reserve(active_.size());
-    for (size_t k = 0; k < forward_ok.size(); ++k) {
-      Active& a = active_[forward_ok[k]];
-      const cv::Point2f p = fwd_pts[k];
-      if (!back_status[k]) {
-        ++stats.lost_lk;
-        continue;
-      }
-      const cv::Point2f d = back_pts[k] - a.px;
-      if (static_cast<double>(d.dot(d)) > fb2 || !std::isfinite(p.x) ||
-          !std::isfinite(p.y)) {
-        ++stats.lost_forward_backward;
-        continue;
-      }
-      if (p.x < margin || p.y < margin || p.x > max_x || p.y > max_y) {
-        ++stats.lost_border;
-        continue;
-      }
-      a.px = p;
-      kept.push_back(std::move(a));
-    }
-    active_ = std::move(kept);
-    if (options_.affine_refinement) {
-      const int interval = options_.affine_interval;
-      std::vector<char> refined(active_.size(), 0),
-          reanchored(active_.size(), 0);
-      std::vector<cv::Point2f> correction(active_.size());
-      tbb::parallel_for(tbb::blocked_range<size_t>(0, active_.size(), 32),
-                        [&](const tbb::blocked_range<size_t>& r) {
-                          for (size_t i = r.begin(); i != r.end(); ++i) {
-                            Active& f = active_[i];
-                            if ((frame_index + f.id) % interval != 0) continue;
-                            const cv::Point2f before = f.px;
-                            bool ref = false, re = false;
-                            RefineFeature(grey, &f, &ref, &re);
-                            refined[i] = ref;
-                            reanchored[i] = re;
-                            correction[i] = f.px - before;
-                          }
-                        });
-      for (size_t i = 0; i < active_.size(); ++i) {
-        stats.refined += refined[i];
-        stats.reanchored += reanchored[i];
-        Active& f = active_[i];
-        if (refined[i]) {
-          // The frames since the last alignment drifted by a growing share
-          // of this correction.
-          const double span = frame_index - f.reference_frame;
-          auto& obs = tracks_[static_cast<size_t>(f.id)].observations;
-          for (auto o = obs.rbegin();
-               o != obs.rend() && o->frame > f.reference_frame; ++o) {
-            const double share = (o->frame - f.reference_frame) / span;
-            o->px += share * Eigen::Vector2d(correction[i].x, correction[i].y);
-          }
-        }
-        if (refined[i] || reanchored[i]) f.reference_frame = frame_index;
-      }
-    }
+    TrackActive(pyramid, &stats);
+    if (options_.affine_refinement) RefineActive(frame_index, grey, &stats);
     for (const Active& a : active_) {
       tracks_[static_cast<size_t>(a.id)].observations.push_back(
           {frame_index, Eigen::Vector2d(a.px.x, a.px.y)});
@@ -235,22 +126,188 @@ void KltTracker::Track(int frame_index, const cv::Mat& grey,
   total_stats_.total += stats.total;
 }
 
-void KltTracker::Detect(int frame_index, const cv::Mat& grey,
-                        KltFrameStats* stats) {
+void KltTracker::CheckFrame(int frame_index, const cv::Mat& grey,
+                            const std::vector<cv::Mat>& pyramid) const {
+  const std::string where = "frame " + std::to_string(frame_index);
+  if (grey.empty() || grey.type() != CV_8UC1) {
+    throw InputError(where + ": tracking needs a non-empty 8-bit grey image");
+  }
+  if (last_frame_ >= 0 && frame_index <= last_frame_) {
+    throw InputError(where + ": frame indices must increase (previous " +
+                     std::to_string(last_frame_) + ")");
+  }
+  if (last_frame_ >= 0 && grey.size() != size_) {
+    throw InputError(where + ": image size " + std::to_string(grey.cols) + "x" +
+                     std::to_string(grey.rows) +
+                     " differs from the first frame's");
+  }
+  if (pyramid.empty()) throw InputError(where + ": empty image pyramid");
+}
+
+void KltTracker::TrackActive(const std::vector<cv::Mat>& pyramid,
+                             KltFrameStats* stats) {
+  std::vector<cv::Point2f> prev_pts(active_.size());
+  for (size_t i = 0; i < active_.size(); ++i) prev_pts[i] = active_[i].px;
+
+  std::vector<cv::Point2f> next_pts;
+  std::vector<uchar> status;
+  std::vector<float> error;
+  PyramidalLk(prev_pyramid_, pyramid, prev_pts, &next_pts, &status, &error,
+              LkOptions(options_));
+
+  // Backward only for the features that survived the forward track.
+  std::vector<size_t> forward_ok;
+  std::vector<cv::Point2f> fwd_pts;
+  for (size_t i = 0; i < active_.size(); ++i) {
+    if (!status[i]) {
+      ++stats->lost_lk;
+    } else if (options_.max_lk_error > 0.0 &&
+               error[i] > options_.max_lk_error) {
+      ++stats->lost_error;
+    } else {
+      forward_ok.push_back(i);
+      fwd_pts.push_back(next_pts[i]);
+    }
+  }
+  std::vector<cv::Point2f> back_pts;
+  std::vector<uchar> back_status;
+  std::vector<float> back_error;
+  if (!fwd_pts.empty()) {
+    // No initial guess at the original position: starting there would
+    // pull the backward track home even from content that changed.
+    PyramidalLk(pyramid, prev_pyramid_, fwd_pts, &back_pts, &back_status,
+                &back_error, LkOptions(options_));
+  }
+  KeepTracked(forward_ok, fwd_pts, back_pts, back_status, stats);
+}
+
+void KltTracker::KeepTracked(const std::vector<size_t>& forward_ok,
+                             const std::vector<cv::Point2f>& fwd_pts,
+                             const std::vector<cv::Point2f>& back_pts,
+                             const std::vector<uchar>& back_status,
+                             KltFrameStats* stats) {
+  const double margin = options_.border_margin_px;
+  const double max_x = size_.width - 1 - margin;
+  const double max_y = size_.height - 1 - margin;
+  const double fb2 = options_.forward_backward_threshold_px *
+                     options_.forward_backward_threshold_px;
+  std::vector<Active> kept;
+  kept.reserve(active_.size());
+  for (size_t k = 0; k < forward_ok.size(); ++k) {
+    Active& a = active_[forward_ok[k]];
+    const cv::Point2f p = fwd_pts[k];
+    if (!back_status[k]) {
+      ++stats->lost_lk;
+      continue;
+    }
+    const cv::Point2f d = back_pts[k] - a.px;
+    if (static_cast<double>(d.dot(d)) > fb2 || !std::isfinite(p.x) ||
+        !std::isfinite(p.y)) {
+      ++stats->lost_forward_backward;
+      continue;
+    }
+    if (p.x < margin || p.y < margin || p.x > max_x || p.y > max_y) {
+      ++stats->lost_border;
+      continue;
+    }
+    a.px = p;
+    kept.push_back(std::move(a));
+  }
+  active_ = std::move(kept);
+}
+
+void KltTracker::RefineActive(int frame_index, const cv::Mat& grey,
+                              KltFrameStats* stats) {
+  const int interval = options_.affine_interval;
+  std::vector<char> refined(active_.size(), 0), reanchored(active_.size(), 0);
+  std::vector<cv::Point2f> correction(active_.size());
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, active_.size(), 32),
+                    [&](const tbb::blocked_range<size_t>& r) {
+                      for (size_t i = r.begin(); i != r.end(); ++i) {
+                        Active& f = active_[i];
+                        if ((frame_index + f.id) % interval != 0) continue;
+                        const cv::Point2f before = f.px;
+                        bool ref = false, re = false;
+                        RefineFeature(grey, &f, &ref, &re);
+                        refined[i] = ref;
+                        reanchored[i] = re;
+                        correction[i] = f.px - before;
+                      }
+                    });
+  for (size_t i = 0; i < active_.size(); ++i) {
+    stats->refined += refined[i];
+    stats->reanchored += reanchored[i];
+    Active& f = active_[i];
+    if (refined[i]) {
+      // The frames since the last alignment drifted by a growing share
+      // of this correction.
+      const double span = frame_index - f.reference_frame;
+      auto& obs = tracks_[static_cast<size_t>(f.id)].observations;
+      for (auto o = obs.rbegin();
+           o != obs.rend() && o->frame > f.reference_frame; ++o) {
+        const double share = (o->frame - f.reference_frame) / span;
+        o->px += share * Eigen::Vector2d(correction[i].x, correction[i].y);
+      }
+    }
+    if (refined[i] || reanchored[i]) f.reference_frame = frame_index;
+  }
+}
+
+int KltTracker::CellOf(const cv::Point2f& p) const {
   const int cols = options_.grid_cols;
   const int rows = options_.grid_rows;
-  const int num_cells = cols * rows;
+  const int cx =
+      std::clamp(static_cast<int>(p.x * cols / size_.width), 0, cols - 1);
+  const int cy =
+      std::clamp(static_cast<int>(p.y * rows / size_.height), 0, rows - 1);
+  return cy * cols + cx;
+}
+
+bool KltTracker::BuildDetectionMask() {
+  // Search only inside the margin and away from existing features (so new
+  // ones do not duplicate them).
+  const int m = static_cast<int>(std::ceil(options_.border_margin_px));
+  const cv::Rect inner(m, m, size_.width - 2 * m, size_.height - 2 * m);
+  if (inner.width <= 0 || inner.height <= 0) return false;
+  mask_.create(size_, CV_8UC1);  // reused: no page faults every frame
+  mask_.setTo(0);
+  mask_(inner).setTo(255);
+  const int radius = static_cast<int>(std::ceil(options_.min_distance_px));
+  if (radius > 0) {
+    for (const Active& a : active_) {
+      cv::circle(mask_, cv::Point(cvRound(a.px.x), cvRound(a.px.y)), radius,
+                 cv::Scalar(0), cv::FILLED);
+    }
+  }
+  return true;
+}
+
+void KltTracker::StartFeature(int frame_index, const cv::Mat& grey,
+                              const cv::Point2f& corner) {
+  const FeatureId id = next_id_++;
+  Active a;
+  a.id = id;
+  a.px = corner;
+  a.reference_frame = frame_index;
+  if (options_.affine_refinement) {
+    a.reference.Extract(grey, Eigen::Vector2f(corner.x, corner.y),
+                        options_.affine);
+  }
+  active_.push_back(std::move(a));
+  monomap::Track track;
+  track.id = id;
+  track.observations.push_back(
+      {frame_index, Eigen::Vector2d(corner.x, corner.y)});
+  tracks_.push_back(std::move(track));
+}
+
+void KltTracker::Detect(int frame_index, const cv::Mat& grey,
+                        KltFrameStats* stats) {
+  const int num_cells = options_.grid_cols * options_.grid_rows;
   const int quota =
       std::max(1, (options_.target_features + num_cells - 1) / num_cells);
-  auto cell_of = [&](const cv::Point2f& p) {
-    const int cx =
-        std::clamp(static_cast<int>(p.x * cols / size_.width), 0, cols - 1);
-    const int cy =
-        std::clamp(static_cast<int>(p.y * rows / size_.height), 0, rows - 1);
-    return cy * cols + cx;
-  };
   std::vector<int> count(num_cells, 0);
-  for (const Active& a : active_) ++count[cell_of(a.px)];
+  for (const Active& a : active_) ++count[CellOf(a.px)];
   int total = static_cast<int>(active_.size());
   // Detection only tops up to the target: features are lost continuously
   // (motion, occlusion), and each top-up serves the short cells first, so
@@ -262,22 +319,7 @@ void KltTracker::Detect(int frame_index, const cv::Mat& grey,
       std::clamp(options_.detection_min_missing, 1, options_.target_features)) {
     return;
   }
-
-  // Search only inside the margin and away from existing features (so new
-  // ones do not duplicate them).
-  const int m = static_cast<int>(std::ceil(options_.border_margin_px));
-  const cv::Rect inner(m, m, size_.width - 2 * m, size_.height - 2 * m);
-  if (inner.width <= 0 || inner.height <= 0) return;
-  mask_.create(size_, CV_8UC1);  // reused: no page faults every frame
-  mask_.setTo(0);
-  mask_(inner).setTo(255);
-  const int radius = static_cast<int>(std::ceil(options_.min_distance_px));
-  if (radius > 0) {
-    for (const Active& a : active_) {
-      cv::circle(mask_, cv::Point(cvRound(a.px.x), cvRound(a.px.y)), radius,
-                 cv::Scalar(0), cv::FILLED);
-    }
-  }
+  if (!BuildDetectionMask()) return;
 
   // Candidates come sorted by corner strength and mutually spaced by
   // min_distance_px. maxCorners = 0: all of them, since the grid below
@@ -291,29 +333,15 @@ void KltTracker::Detect(int frame_index, const cv::Mat& grey,
   std::vector<bool> taken(corners.size(), false);
   auto start = [&](size_t k) {
     taken[k] = true;
-    const FeatureId id = next_id_++;
-    Active a;
-    a.id = id;
-    a.px = corners[k];
-    a.reference_frame = frame_index;
-    if (options_.affine_refinement) {
-      a.reference.Extract(grey, Eigen::Vector2f(corners[k].x, corners[k].y),
-                          options_.affine);
-    }
-    active_.push_back(std::move(a));
-    monomap::Track track;
-    track.id = id;
-    track.observations.push_back(
-        {frame_index, Eigen::Vector2d(corners[k].x, corners[k].y)});
-    tracks_.push_back(std::move(track));
-    ++count[cell_of(corners[k])];
+    StartFeature(frame_index, grey, corners[k]);
+    ++count[CellOf(corners[k])];
     ++total;
     ++stats->detected;
   };
   // First fill the cells short of their share (spread over the image) ...
   for (size_t k = 0; k < corners.size() && total < options_.target_features;
        ++k) {
-    if (count[cell_of(corners[k])] < quota) start(k);
+    if (count[CellOf(corners[k])] < quota) start(k);
   }
   // ... then, if textureless cells left the total short, take the
   // strongest remaining corners anywhere.

@@ -165,7 +165,30 @@ class KltTracker {
   // *refined / *reanchored.
   void RefineFeature(const cv::Mat& grey, Active* f, bool* refined,
                      bool* reanchored) const;
+  // Throws InputError naming the frame if it cannot follow the last one.
+  void CheckFrame(int frame_index, const cv::Mat& grey,
+                  const std::vector<cv::Mat>& pyramid) const;
+  // Tracks the active features into `pyramid` (forward, then backward
+  // from the survivors); drops the lost ones, counting why in *stats.
+  void TrackActive(const std::vector<cv::Mat>& pyramid, KltFrameStats* stats);
+  // Keeps the forward-tracked features (indices forward_ok, at fwd_pts)
+  // whose backward track returns and that stay inside the margin.
+  void KeepTracked(const std::vector<size_t>& forward_ok,
+                   const std::vector<cv::Point2f>& fwd_pts,
+                   const std::vector<cv::Point2f>& back_pts,
+                   const std::vector<uchar>& back_status, KltFrameStats* stats);
+  // Affine refinement of the features due this frame; spreads each
+  // correction over the observations since their last alignment.
+  void RefineActive(int frame_index, const cv::Mat& grey, KltFrameStats* stats);
   void Detect(int frame_index, const cv::Mat& grey, KltFrameStats* stats);
+  // Detection grid cell of a pixel.
+  int CellOf(const cv::Point2f& p) const;
+  // mask_: inside the margin, away from active features. False if the
+  // margin leaves no image.
+  bool BuildDetectionMask();
+  // A new feature and track at `corner`.
+  void StartFeature(int frame_index, const cv::Mat& grey,
+                    const cv::Point2f& corner);
 
   KltTrackerOptions options_;
   int last_frame_ = -1;

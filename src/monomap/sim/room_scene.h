@@ -1,8 +1,10 @@
-// A small synthetic world for the localization tests and benchmark: a
-// 4 x 3 m room (floor and four 1.2 m walls with random-blob textures), a
-// camera with mild lens distortion on a planar robot, and "live" images
-// rendered from ground-truth poses with the same Renderer, then distorted,
-// with a gain change and noise. Header-only; not part of the library API.
+// A small room for the localization tests and benchmark: a 4 x 3 m room
+// (floor and four 1.2 m walls with random-blob textures), a camera with
+// mild lens distortion on a planar robot, and "live" images rendered from
+// ground-truth poses with the map's Renderer, then distorted, with a gain
+// change and noise. Header-only; not part of the library API. (Point-track
+// scenes: synthetic_scene.h; ray-cast textured planes:
+// textured_plane_scene.h.)
 #pragma once
 
 #include <algorithm>
@@ -16,9 +18,9 @@
 #include "monomap/geometry/pose2d.h"
 #include "monomap/map/map.h"
 #include "monomap/rendering/renderer.h"
+#include "monomap/util/angles.h"
 
-namespace monomap {
-namespace test_scene {
+namespace monomap::testing {
 
 // Random blobs of random grey on a smooth random background, opaque BGRA.
 inline cv::Mat BlobTexture(int cols, int rows, uint64_t seed) {
@@ -95,7 +97,7 @@ inline Camera LiveCamera() {
 // Camera 0.5 m above the base, 0.1 m ahead, looking along base +x and
 // pitched 20 degrees down.
 inline Rigid3d BaseFromCam() {
-  const double pitch = 20.0 * M_PI / 180.0;
+  const double pitch = DegToRadMulDiv(20.0);
   const Eigen::Vector3d z(std::cos(pitch), 0, -std::sin(pitch));
   const Eigen::Vector3d x(0, -1, 0);
   const Eigen::Vector3d y = z.cross(x);
@@ -137,5 +139,4 @@ inline cv::Mat LiveImage(const Renderer& renderer, const Camera& camera,
   return out;
 }
 
-}  // namespace test_scene
-}  // namespace monomap
+}  // namespace monomap::testing
