@@ -85,6 +85,9 @@ struct SweepOptions {
   // MCC: width of the estimate's refinement (0: off; -1: the localizer's
   // default).
   int refine_width = -1;
+  // MCC: the refinement stops after a round that moved less than this (px;
+  // negative: the localizer's default).
+  double refine_converged_px = -1.0;
   // MCC: least random particles injected per resampling (-1: the
   // localizer's default).
   int mcc_min_injected = -1;
@@ -330,6 +333,9 @@ nlohmann::json RunSeed(const SweepOptions& o, const std::string& world,
     if (o.sigma > 0) lo.mcl.measurement.sigma = o.sigma;
     if (o.refine_width == 0) lo.mcc.refine_estimate = false;
     if (o.refine_width > 0) lo.mcc.refinement.width = o.refine_width;
+    if (o.refine_converged_px >= 0) {
+      lo.mcc.refinement.converged_px = o.refine_converged_px;
+    }
     if (o.mcc_min_injected >= 0) {
       lo.recovery.mcc_min_injected = o.mcc_min_injected;
     }
@@ -371,6 +377,7 @@ nlohmann::json RunSeed(const SweepOptions& o, const std::string& world,
                    steps_weighed = nlohmann::json::array(),
                    steps_ms = nlohmann::json::array(),
                    steps_ncc = nlohmann::json::array(),
+                   steps_coverage = nlohmann::json::array(),
                    steps_cluster = nlohmann::json::array(),
                    steps_injected = nlohmann::json::array(),
                    steps_relocalizing = nlohmann::json::array(),
@@ -389,6 +396,7 @@ nlohmann::json RunSeed(const SweepOptions& o, const std::string& world,
       steps_weighed.push_back(s.particles_weighed);
       steps_ms.push_back(1e3 * s.seconds);
       steps_ncc.push_back(s.best_ncc);
+      steps_coverage.push_back(s.best_coverage);
       steps_cluster.push_back(s.cluster_weight);
       steps_injected.push_back(s.injected);
     }
@@ -427,6 +435,7 @@ nlohmann::json RunSeed(const SweepOptions& o, const std::string& world,
         {"weighed_per_step", steps_weighed},
         {"ms_per_step", steps_ms},
         {"best_ncc_per_step", steps_ncc},
+        {"best_coverage_per_step", steps_coverage},
         {"cluster_weight_per_step", steps_cluster},
         {"injected_per_step", steps_injected},
         {"relocalizing_per_step", steps_relocalizing},
@@ -615,6 +624,7 @@ int Run(const SweepOptions& o) {
       {"mcc_min_injected", o.mcc_min_injected},
       {"sigma", o.sigma},
       {"refine_width", o.refine_width},
+      {"refine_converged_px", o.refine_converged_px},
       {"mcc_max_rotation_deg", o.mcc_max_rotation_deg},
       {"relocalize_ncc_drop", o.relocalize_ncc_drop},
       {"relocalize_fraction", o.relocalize_fraction},
@@ -692,6 +702,9 @@ int main(int argc, char** argv) {
   app.add_option("--refine-width", o.refine_width,
                  "MCC: width of the estimate's refinement (0: off; -1: the "
                  "localizer's default)");
+  app.add_option("--refine-converged-px", o.refine_converged_px,
+                 "MCC: the refinement stops after a round that moved less "
+                 "than this (px; negative: the localizer's default)");
   app.add_option("--mcc-min-injected", o.mcc_min_injected,
                  "MCC: least random particles injected per resampling "
                  "(-1: the localizer's default)");
