@@ -108,7 +108,7 @@ struct LocalizerStepStats {
   double cluster_weight = 0.0;  // weight share of the estimate's cluster
   int kld_bins = 0;
   int injected = 0;
-  bool relocalizing = false;  // relocalize_ncc_drop was exceeded this update
+  bool relocalizing = false;  // the relocalization trigger holds (recovery.h)
   int mcc_attempted = 0;
   int mcc_accepted = 0;
   int merged = 0;
