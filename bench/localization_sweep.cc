@@ -15,6 +15,11 @@
 // happened. The figures are then those of the updates after the kidnapping
 // (converged step = updates until the filter has the pose again).
 //
+// With --track the filter starts at the true pose and nobody kidnaps it:
+// every update the relocalization trigger fires is a false alarm. The
+// summary gives that share beside the CPU time per update (all threads:
+// the cores the filter needs to keep up) and its 95th percentile.
+//
 // Writes every figure (and the per-step errors and particle counts) to
 // --out as JSON and prints markdown summary tables on stdout.
 //
@@ -82,6 +87,9 @@ struct SweepOptions {
   // MCC: width of the estimate's refinement (0: off; -1: the localizer's
   // default).
   int refine_width = -1;
+  // MCC: the refinement stops after a round that moved less than this (px;
+  // negative: the localizer's default).
+  double refine_converged_px = -1.0;
   // MCC: least random particles injected per resampling (-1: the
   // localizer's default).
   int mcc_min_injected = -1;
@@ -98,6 +106,11 @@ struct SweepOptions {
   int kidnap_after = 0;
   // ... this many frames ahead along the traversal.
   int kidnap_skip = 60;
+  // Start at the true pose without kidnapping (false-alarm runs).
+  bool track = false;
+  // Configurations to run (empty: all; names as in the summary, e.g.
+  // mcc_3000).
+  std::vector<std::string> configs;
   LocalizationAccuracyOptions accuracy;
   std::string out = "localization_sweep.json";
   std::string keep_dir;
@@ -119,6 +132,11 @@ struct ConfigRun {
   double mean_step_ms = 0.0;
   double mean_particles = 0.0;
   std::vector<int> particles;  // per step, after the update
+  // Updates judged for false alarms (all with --track; those before the
+  // kidnapping otherwise) and how many of them relocalized.
+  int judged_steps = 0;
+  int false_alarms = 0;
+  std::vector<double> cpu_ms;  // per step, all threads
 };
 
 // Median of the finite values (failed runs report NaN errors); NaN if
@@ -134,6 +152,15 @@ double Mean(const std::vector<double>& v) {
   double s = 0.0;
   for (double x : v) s += x;
   return s / v.size();
+}
+
+// The q-quantile (nearest rank) of the finite values; NaN if none.
+double Percentile(std::vector<double> v, double q) {
+  std::erase_if(v, [](double x) { return !std::isfinite(x); });
+  if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
+  std::sort(v.begin(), v.end());
+  const size_t k = static_cast<size_t>(std::ceil(q * v.size()));
+  return v[std::clamp<size_t>(k, 1, v.size()) - 1];
 }
 
 nlohmann::json Number(double v) {
@@ -295,7 +322,8 @@ nlohmann::json RunSeed(const SweepOptions& o, const std::string& world,
     LocalizerOptions& lo = po.localizer;
     lo.method = configs[c].method;
     lo.state = LocalizationState::kPlanar;
-    lo.init.kind = kidnap ? LocalizationInit::kPose : LocalizationInit::kGlobal;
+    lo.init.kind =
+        kidnap || o.track ? LocalizationInit::kPose : LocalizationInit::kGlobal;
     lo.mcl.num_particles = configs[c].particles;
     lo.mcl.use_kld = !o.fixed_count;
     lo.mcl.kld.max_particles = configs[c].particles;
@@ -305,6 +333,9 @@ nlohmann::json RunSeed(const SweepOptions& o, const std::string& world,
     if (o.sigma > 0) lo.mcl.measurement.sigma = o.sigma;
     if (o.refine_width == 0) lo.mcc.refine_estimate = false;
     if (o.refine_width > 0) lo.mcc.refinement.width = o.refine_width;
+    if (o.refine_converged_px >= 0) {
+      lo.mcc.refinement.converged_px = o.refine_converged_px;
+    }
     if (o.mcc_min_injected >= 0) {
       lo.recovery.mcc_min_injected = o.mcc_min_injected;
     }
@@ -346,14 +377,26 @@ nlohmann::json RunSeed(const SweepOptions& o, const std::string& world,
                    steps_weighed = nlohmann::json::array(),
                    steps_ms = nlohmann::json::array(),
                    steps_ncc = nlohmann::json::array(),
+                   steps_coverage = nlohmann::json::array(),
                    steps_cluster = nlohmann::json::array(),
-                   steps_injected = nlohmann::json::array();
-    for (const LocalizerStepStats& s : r.steps) {
+                   steps_injected = nlohmann::json::array(),
+                   steps_relocalizing = nlohmann::json::array(),
+                   steps_cpu_ms = nlohmann::json::array();
+    for (size_t k = 0; k < r.steps.size(); ++k) {
+      const LocalizerStepStats& s = r.steps[k];
+      if (!kidnap || static_cast<int>(k) < o.kidnap_after) {
+        ++run.judged_steps;
+        run.false_alarms += s.relocalizing;
+      }
+      run.cpu_ms.push_back(1e3 * s.cpu_seconds);
+      steps_relocalizing.push_back(s.relocalizing ? 1 : 0);
+      steps_cpu_ms.push_back(1e3 * s.cpu_seconds);
       run.particles.push_back(s.particles);
       steps_particles.push_back(s.particles);
       steps_weighed.push_back(s.particles_weighed);
       steps_ms.push_back(1e3 * s.seconds);
       steps_ncc.push_back(s.best_ncc);
+      steps_coverage.push_back(s.best_coverage);
       steps_cluster.push_back(s.cluster_weight);
       steps_injected.push_back(s.injected);
     }
@@ -392,8 +435,13 @@ nlohmann::json RunSeed(const SweepOptions& o, const std::string& world,
         {"weighed_per_step", steps_weighed},
         {"ms_per_step", steps_ms},
         {"best_ncc_per_step", steps_ncc},
+        {"best_coverage_per_step", steps_coverage},
         {"cluster_weight_per_step", steps_cluster},
-        {"injected_per_step", steps_injected}};
+        {"injected_per_step", steps_injected},
+        {"relocalizing_per_step", steps_relocalizing},
+        {"cpu_ms_per_step", steps_cpu_ms},
+        {"false_alarms", run.false_alarms},
+        {"judged_steps", run.judged_steps}};
     std::fprintf(
         stderr, " %s %s (%s, %.1f cm)", configs[c].name.c_str(),
         run.accuracy.success ? "ok" : "FAIL",
@@ -430,12 +478,15 @@ nlohmann::json Summarize(const SweepOptions& o, const std::string& world,
   std::printf(
       "| method | particles | success | median converged step | "
       "median final error | median mean tracking error (converged "
-      "runs) | mean particles | mean ms / update |\n");
-  std::printf("|---|---|---|---|---|---|---|---|\n");
+      "runs) | mean particles | mean ms / update | CPU ms / update: mean, "
+      "p95 | false alarms |\n");
+  std::printf("|---|---|---|---|---|---|---|---|---|---|\n");
   std::vector<std::string> over_time;
   for (size_t c = 0; c < configs.size(); ++c) {
     int ok = 0, success = 0, tracked = 0;
     std::vector<double> conv, final_t, final_r, mean_t, mean_r, particles, ms;
+    std::vector<double> cpu_ms;
+    int judged = 0, alarms = 0;
     std::vector<double> at_step(kParticleSteps.size(), 0.0);
     std::vector<int> at_count(kParticleSteps.size(), 0);
     for (const auto& seed_runs : runs) {
@@ -454,6 +505,9 @@ nlohmann::json Summarize(const SweepOptions& o, const std::string& world,
       final_r.push_back(a.final_rotation_error_deg);
       particles.push_back(r.mean_particles);
       ms.push_back(r.mean_step_ms);
+      cpu_ms.insert(cpu_ms.end(), r.cpu_ms.begin(), r.cpu_ms.end());
+      judged += r.judged_steps;
+      alarms += r.false_alarms;
       for (size_t k = 0; k < kParticleSteps.size(); ++k) {
         if (kParticleSteps[k] < static_cast<int>(r.particles.size())) {
           at_step[k] += r.particles[kParticleSteps[k]];
@@ -477,6 +531,14 @@ nlohmann::json Summarize(const SweepOptions& o, const std::string& world,
     s["median_mean_rotation_error_deg"] = Number(FiniteMedian(mean_r));
     s["mean_particles"] = Number(Mean(particles));
     s["mean_ms_per_update"] = Number(Mean(ms));
+    const double cpu_p95 = Percentile(cpu_ms, 0.95);
+    s["mean_cpu_ms_per_update"] = Number(Mean(cpu_ms));
+    s["p95_cpu_ms_per_update"] = Number(cpu_p95);
+    s["false_alarm_steps"] = alarms;
+    s["judged_steps"] = judged;
+    const double alarm_pct = judged > 0
+                                 ? 100.0 * alarms / judged
+                                 : std::numeric_limits<double>::quiet_NaN();
     nlohmann::json pt = nlohmann::json::object();
     std::string row = "| " + configs[c].name + " |";
     for (size_t k = 0; k < kParticleSteps.size(); ++k) {
@@ -490,7 +552,7 @@ nlohmann::json Summarize(const SweepOptions& o, const std::string& world,
     summary[configs[c].name] = s;
     std::printf(
         "| %s | %d | %d/%d%s | %s | %s cm / %s deg | %s cm / %s deg | "
-        "%s | %s |\n",
+        "%s | %s | %s, %s | %d/%d (%s %%) |\n",
         s["method"].get<std::string>().c_str(), configs[c].particles, success,
         n,
         o.kidnap_after > 0
@@ -501,7 +563,9 @@ nlohmann::json Summarize(const SweepOptions& o, const std::string& world,
         Fmt("%.1f", FiniteMedian(final_r)).c_str(),
         Fmt("%.1f", 100 * FiniteMedian(mean_t)).c_str(),
         Fmt("%.2f", FiniteMedian(mean_r)).c_str(),
-        Fmt("%.0f", Mean(particles)).c_str(), Fmt("%.1f", Mean(ms)).c_str());
+        Fmt("%.0f", Mean(particles)).c_str(), Fmt("%.1f", Mean(ms)).c_str(),
+        Fmt("%.1f", Mean(cpu_ms)).c_str(), Fmt("%.1f", cpu_p95).c_str(), alarms,
+        judged, Fmt("%.1f", alarm_pct).c_str());
   }
   std::printf(
       "\nParticles alive (mean over seeds) after step%s:\n\n| "
@@ -522,13 +586,19 @@ int Run(const SweepOptions& o) {
   CheckOption(o.particles >= 4, "particles", "must be >= 4");
   CheckOption(o.map_frames >= 10 && o.loc_frames >= 2, "frames",
               "map >= 10, localization >= 2");
-  const std::vector<Config> configs = {
-      {"mcl_" + std::to_string(o.particles), LocalizationMethod::kMcl,
-       o.particles},
-      {"mcc_" + std::to_string(o.particles), LocalizationMethod::kMcc,
-       o.particles},
-      {"mcc_" + std::to_string(o.particles / 4), LocalizationMethod::kMcc,
-       o.particles / 4}};
+  std::vector<Config> configs = {{"mcl_" + std::to_string(o.particles),
+                                  LocalizationMethod::kMcl, o.particles},
+                                 {"mcc_" + std::to_string(o.particles),
+                                  LocalizationMethod::kMcc, o.particles},
+                                 {"mcc_" + std::to_string(o.particles / 4),
+                                  LocalizationMethod::kMcc, o.particles / 4}};
+  if (!o.configs.empty()) {
+    std::erase_if(configs, [&](const Config& c) {
+      return std::find(o.configs.begin(), o.configs.end(), c.name) ==
+             o.configs.end();
+    });
+    CheckOption(!configs.empty(), "configs", "names none of mcl_N, mcc_N");
+  }
   const fs::path root =
       o.keep_dir.empty()
           ? fs::temp_directory_path() /
@@ -554,6 +624,7 @@ int Run(const SweepOptions& o) {
       {"mcc_min_injected", o.mcc_min_injected},
       {"sigma", o.sigma},
       {"refine_width", o.refine_width},
+      {"refine_converged_px", o.refine_converged_px},
       {"mcc_max_rotation_deg", o.mcc_max_rotation_deg},
       {"relocalize_ncc_drop", o.relocalize_ncc_drop},
       {"relocalize_fraction", o.relocalize_fraction},
@@ -561,7 +632,8 @@ int Run(const SweepOptions& o) {
       {"max_translation_error_m", o.accuracy.max_translation_error_m},
       {"max_rotation_error_deg", o.accuracy.max_rotation_error_deg},
       {"state", "planar"},
-      {"init", o.kidnap_after > 0 ? "pose" : "global"},
+      {"init", o.kidnap_after > 0 || o.track ? "pose" : "global"},
+      {"track", o.track},
       {"kidnap_after", o.kidnap_after},
       {"kidnap_skip", o.kidnap_skip}};
   out["runs"] = nlohmann::json::array();
@@ -630,6 +702,9 @@ int main(int argc, char** argv) {
   app.add_option("--refine-width", o.refine_width,
                  "MCC: width of the estimate's refinement (0: off; -1: the "
                  "localizer's default)");
+  app.add_option("--refine-converged-px", o.refine_converged_px,
+                 "MCC: the refinement stops after a round that moved less "
+                 "than this (px; negative: the localizer's default)");
   app.add_option("--mcc-min-injected", o.mcc_min_injected,
                  "MCC: least random particles injected per resampling "
                  "(-1: the localizer's default)");
@@ -650,6 +725,13 @@ int main(int argc, char** argv) {
                  "many updates (0: global initialisation instead)");
   app.add_option("--kidnap-skip", o.kidnap_skip,
                  "Frames along the traversal the robot is carried ahead");
+  app.add_flag("--track", o.track,
+               "Start at the true pose, no kidnapping: relocalizing counts "
+               "as a false alarm");
+  app.add_option("--configs", o.configs,
+                 "Configurations to run (comma-separated, e.g. "
+                 "mcc_3000,mcc_750; default all)")
+      ->delimiter(',');
   app.add_option("--max-error-m", o.accuracy.max_translation_error_m,
                  "Success threshold on the position error (m)");
   app.add_option("--max-error-deg", o.accuracy.max_rotation_error_deg,

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <ctime>
 #include <limits>
 
 #include "monomap/util/error.h"
@@ -12,6 +13,13 @@ namespace monomap {
 namespace {
 
 constexpr double kDegToRad = M_PI / 180.0;
+
+// CPU seconds used by the process so far (all threads).
+double ProcessCpuSeconds() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
 
 }  // namespace
 
@@ -109,12 +117,13 @@ SamplingArea AreaOf(const Map& map, const InitializationOptions& options) {
           hi.array() + options.area_margin_m};
 }
 
-double BestLogLikelihood(const std::vector<MeasurementScore>& scores) {
-  double best = -std::numeric_limits<double>::infinity();
-  for (const MeasurementScore& s : scores) {
-    best = std::max(best, s.log_likelihood);
-  }
-  return best;
+// The score of the highest likelihood this update.
+const MeasurementScore& BestScore(const std::vector<MeasurementScore>& scores) {
+  return *std::max_element(
+      scores.begin(), scores.end(),
+      [](const MeasurementScore& a, const MeasurementScore& b) {
+        return a.log_likelihood < b.log_likelihood;
+      });
 }
 
 }  // namespace
@@ -131,7 +140,7 @@ Localizer::Localizer(const Map& map, const Camera& camera,
               ? std::make_unique<MccCorrection>(&renderer_, camera, options.mcc)
               : nullptr),
       recovery_(options.recovery, options.method == LocalizationMethod::kMcc,
-                options.mcl.num_particles, options.mcl.measurement.sigma),
+                options.mcl.num_particles),
       map_has_trajectory_(!map.trajectory.empty()),
       rng_(options.seed) {
   if (renderer_.num_planes() == 0) {
@@ -190,6 +199,7 @@ LocalizerEstimate Localizer::Step(const cv::Mat& live_image_raw,
     throw StageError("localizer: Step before Initialize");
   }
   const Timer timer;
+  const double cpu_start = ProcessCpuSeconds();
   LocalizerStepStats stats;
   const LiveFrame live(live_image_raw, measurement_.preparer(), live_sizes_);
   Predict(odometry);
@@ -205,7 +215,9 @@ LocalizerEstimate Localizer::Step(const cv::Mat& live_image_raw,
   stats.best_ncc = scores[best].ncc;
   LocalizerEstimate estimate = Estimate(live, weights, &stats);
 
-  stats.relocalizing = recovery_.Update(BestLogLikelihood(scores));
+  const MeasurementScore& top = BestScore(scores);
+  stats.best_coverage = top.coverage;
+  stats.relocalizing = recovery_.Update(top.ncc, top.coverage);
   if (stats.ess <
       options_.mcl.resample_ess_fraction * particles_.size() + 1e-9) {
     Resample(weights, &stats);
@@ -216,6 +228,7 @@ LocalizerEstimate Localizer::Step(const cv::Mat& live_image_raw,
   }
   stats.particles = static_cast<int>(particles_.size());
   stats.seconds = timer.ElapsedSeconds();
+  stats.cpu_seconds = ProcessCpuSeconds() - cpu_start;
   estimate.stats = stats;
   return estimate;
 }

@@ -102,10 +102,13 @@ struct LocalizerStepStats {
   double ess = 0.0;           // before resampling
   double max_weight = 0.0;    // normalized, before resampling
   double best_ncc = 0.0;
+  // Share of the view the map covers, for the highest likelihood this
+  // update (what the relocalization trigger judges by).
+  double best_coverage = 0.0;
   double cluster_weight = 0.0;  // weight share of the estimate's cluster
   int kld_bins = 0;
   int injected = 0;
-  bool relocalizing = false;  // relocalize_ncc_drop was exceeded this update
+  bool relocalizing = false;  // the relocalization trigger holds (recovery.h)
   int mcc_attempted = 0;
   int mcc_accepted = 0;
   int merged = 0;
@@ -114,6 +117,9 @@ struct LocalizerStepStats {
   double weigh_seconds = 0.0;  // rendering + NCC of every particle
   double mcc_seconds = 0.0;    // corrections (MCC only), refinement included
   double seconds = 0.0;        // the whole step
+  // CPU time of the whole process during the step, all threads: the
+  // share of cores the filter needs to keep up, whatever else runs.
+  double cpu_seconds = 0.0;
 };
 
 struct LocalizerEstimate {

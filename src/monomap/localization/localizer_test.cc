@@ -351,6 +351,68 @@ TEST_F(LocalizerTest, RelocalizationRecoversFromAKidnappingWhileTracking) {
   for (const LocalizerStepStats& s : off_stats) EXPECT_FALSE(s.relocalizing);
 }
 
+// The room's map cut at x = 1.2 m (the far wall and everything beyond
+// dropped): the world the camera sees is still the whole room.
+Map PartialRoomMap(const Map& room) {
+  Map map = room;
+  constexpr double kCut = 1.2 - (-1.0);  // along x from the room's x0
+  map.planes[0].polygon = {{0, 0}, {kCut, 0}, {kCut, 3.0}, {0, 3.0}};
+  map.planes[3].polygon = {{0, 0}, {kCut, 0}, {kCut, 1.2}, {0, 1.2}};
+  map.planes[4].polygon = {
+      {4.0 - kCut, 0}, {4.0, 0}, {4.0, 1.2}, {4.0 - kCut, 1.2}};
+  map.planes.erase(map.planes.begin() + 1);  // the far wall
+  return map;
+}
+
+// Tracking towards the map's edge: the views hold less and less map (as
+// on a robot that drives out of the mapped area) while the pose stays
+// right (within 3 cm). The trigger must stay quiet; judged on every view
+// (coverage threshold 0, no persistence) it fires as the map leaves the
+// view.
+TEST_F(LocalizerTest, RelocalizationStaysQuietAsTheMapLeavesTheView) {
+  const Map partial = PartialRoomMap(map());
+  // 26 updates: beyond them the map fills a tenth of the view and MCC
+  // loses the pose for real.
+  const Drive drive = MakeDrive({0.0, 0.1, 0.0}, 26, 0.02, 0.2 * kDeg, 11);
+  auto run = [&](double min_coverage, int min_updates,
+                 std::vector<LocalizerStepStats>* stats) {
+    LocalizerOptions o = PlanarOverUnitArea(LocalizationMethod::kMcc, 200, 50);
+    o.init.spread_m = 0.01;
+    o.init.spread_deg = 1.0;
+    o.recovery.relocalize_min_coverage = min_coverage;
+    o.recovery.relocalize_min_updates = min_updates;
+    o.seed = 4;
+    Localizer loc(partial, camera(), o, mount());
+    loc.InitializeAtPose(WorldFromCamOfBase(drive.truth[0], mount()));
+    return Run(drive, &loc, stats);
+  };
+  std::vector<LocalizerStepStats> on, every;
+  const std::vector<double> errors =
+      run(RecoveryOptions().relocalize_min_coverage,
+          RecoveryOptions().relocalize_min_updates, &on);
+  run(0.0, 1, &every);
+  std::string fired, fired_every, coverage;
+  for (size_t i = 0; i < on.size(); ++i) {
+    fired += on[i].relocalizing ? '1' : '0';
+    fired_every += every[i].relocalizing ? '1' : '0';
+    if (i % 5 == 0) {
+      char buf[64];
+      std::snprintf(buf, sizeof(buf), " %.2f (%.3f m)", on[i].best_coverage,
+                    errors[i]);
+      coverage += buf;
+    }
+  }
+  std::printf(
+      "coverage (error) every 5 updates:%s\nrelocalizing %s\njudging every "
+      "view %s\nlast error %.4f m\n",
+      coverage.c_str(), fired.c_str(), fired_every.c_str(), errors.back());
+  EXPECT_LT(on.back().best_coverage, 0.2);
+  EXPECT_GT(on.front().best_coverage, 0.35);
+  EXPECT_LT(Max(errors), 0.03);
+  EXPECT_EQ(std::count(fired.begin(), fired.end(), '1'), 0);
+  EXPECT_GT(std::count(fired_every.begin(), fired_every.end(), '1'), 0);
+}
+
 TEST_F(LocalizerTest, SixDofGlobalInitKeepsHeightAndTilt) {
   LocalizerOptions o;
   o.state = LocalizationState::k6Dof;

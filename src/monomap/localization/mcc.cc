@@ -33,6 +33,7 @@ void MccOptions::Check() const {
   CheckOption(max_translation_m > 0, "mcc.max_translation_m", "must be > 0");
   CheckOption(max_rotation_deg > 0, "mcc.max_rotation_deg", "must be > 0");
   CheckOption(iterations >= 1, "mcc.iterations", "must be >= 1");
+  CheckOption(converged_px >= 0, "mcc.converged_px", "must be >= 0");
   CheckOption(std::isfinite(extra_mip_bias) && std::abs(extra_mip_bias) <= 4,
               "mcc.extra_mip_bias", "must be finite, within [-4, 4]");
 }
@@ -226,6 +227,19 @@ bool SolvePose(const Matches& m, const Camera& c, const MccOptions& o,
   }
   stats->rms_reprojection_px = best_rms;
   if (!(best_rms <= o.ransac_threshold_px)) return false;
+  // How far the solved pose moves the inliers' projections from where the
+  // start pose put them.
+  cv::Mat r0, t0 = cv::Mat();
+  r0 = CvFromRigid(start.Inverse(), &t0);
+  std::vector<cv::Point2d> before, after;
+  cv::projectPoints(in_obj, r0, t0, k, cv::noArray(), before);
+  cv::projectPoints(in_obj, rvec, tvec, k, cv::noArray(), after);
+  double sum_sq = 0.0;
+  for (size_t i = 0; i < before.size(); ++i) {
+    const cv::Point2d d = after[i] - before[i];
+    sum_sq += d.dot(d);
+  }
+  stats->shift_px = std::sqrt(sum_sq / before.size());
   *out = RigidFromCv(rvec, tvec).Inverse();
   return true;
 }
@@ -268,8 +282,10 @@ MccResult MonteCarloCorrector::Correct(const cv::Mat& live,
       break;
     }
     r = round_stats;
+    r.rounds = it + 1;
     pose = next;
     any = true;
+    if (r.shift_px < options_.converged_px) break;
   }
   r.world_from_cam = world_from_cam;
   r.accepted = false;

@@ -52,6 +52,10 @@ struct MccOptions {
   // Render-track-solve rounds; the second one starts from an almost
   // aligned render and removes most of the first round's bias.
   int iterations = 2;
+  // A round that moved the inliers' projections by less than this (RMS,
+  // px) started from an aligned render already: the next round would
+  // repeat it, so the correction stops. 0: always all iterations.
+  double converged_px = 0.0;
 
   void Check() const;
 };
@@ -64,6 +68,8 @@ struct MccResult {
   int tracked = 0;         // passed the forward-backward check
   int inliers = 0;         // PnP inliers
   double rms_reprojection_px = 0.0;  // over inliers, at options' size
+  double shift_px = 0.0;  // RMS move of the inliers' projections (last round)
+  int rounds = 0;         // render-track-solve rounds run
   double translation_change_m = 0.0;
   double rotation_change_deg = 0.0;
 };

@@ -72,6 +72,30 @@ TEST_F(MccTest, CorrectsAnOffsetParticle) {
 
 // The basin reaches well beyond a few centimetres: 20 cm back along the
 // optical axis (the view shrinks by ~10 %) and 2 degrees of yaw.
+// A correction started at the truth moves the inliers by a fraction of a
+// pixel: with converged_px 0.5 it stops after one round, without it runs
+// both; started 2 cm and 1 deg off, the first round moves them further
+// and the second runs too.
+TEST_F(MccTest, StopsIteratingOnceARoundMovesLessThanConvergedPx) {
+  MccOptions o;
+  o.converged_px = 0.5;
+  const MonteCarloCorrector early(&renderer_, camera_, o);
+  for (const auto& [truth, live] : Views()) {
+    const MccResult at = early.Correct(live, truth);
+    ASSERT_TRUE(at.accepted);
+    EXPECT_LT(at.shift_px, 0.5);
+    EXPECT_EQ(at.rounds, 1);
+    EXPECT_EQ(mcc_.Correct(live, truth).rounds, 2);
+    const Rigid3d off(
+        QuaternionFromRotationVector({0, 1 * kDeg, 0}) * truth.rotation,
+        truth.translation + Eigen::Vector3d(0.02, -0.01, 0));
+    const MccResult r = early.Correct(live, off);
+    ASSERT_TRUE(r.accepted);
+    EXPECT_EQ(r.rounds, 2);
+    EXPECT_LT((r.world_from_cam.translation - truth.translation).norm(), 0.01);
+  }
+}
+
 TEST_F(MccTest, CorrectsTwentyCentimetresAlongTheViewAxis) {
   int n = 0;
   for (const auto& [truth, live] : Views()) {

@@ -12,6 +12,10 @@ void RecoveryOptions::Check() const {
               "injection_fraction", "must be in [0, 1)");
   CheckOption(mcc_min_injected >= 0, "mcc_min_injected", "must be >= 0");
   CheckOption(relocalize_ncc_drop >= 0, "relocalize_ncc_drop", "must be >= 0");
+  CheckOption(relocalize_min_coverage >= 0 && relocalize_min_coverage < 1,
+              "relocalize_min_coverage", "must be in [0, 1)");
+  CheckOption(relocalize_min_updates >= 1, "relocalize_min_updates",
+              "must be >= 1");
   CheckOption(relocalize_fraction >= 0 && relocalize_fraction < 1,
               "relocalize_fraction", "must be in [0, 1)");
   CheckOption(relocalize_alpha_fast > 0 && relocalize_alpha_fast <= 1,
@@ -22,25 +26,31 @@ void RecoveryOptions::Check() const {
 }
 
 RecoveryEstimator::RecoveryEstimator(const RecoveryOptions& options,
-                                     bool with_mcc, int budget, double sigma)
-    : options_(options), with_mcc_(with_mcc), budget_(budget), sigma_(sigma) {
+                                     bool with_mcc, int budget)
+    : options_(options), with_mcc_(with_mcc), budget_(budget) {
   options_.Check();
   CheckOption(budget >= 1, "recovery budget", "must be >= 1");
-  CheckOption(sigma > 0, "recovery sigma", "must be > 0");
 }
 
-bool RecoveryEstimator::Update(double best_log_likelihood) {
-  relocalizing_ = false;
-  if (!(options_.relocalize_ncc_drop > 0)) return false;
+bool RecoveryEstimator::Update(double best_ncc, double best_coverage) {
+  if (!(options_.relocalize_ncc_drop > 0)) return relocalizing_ = false;
+  // Too little map in view to judge: everything stays as it was.
+  if (!(best_coverage >= options_.relocalize_min_coverage)) {
+    return relocalizing_;
+  }
   if (!has_average_) {
-    fast_ = slow_ = best_log_likelihood;
+    fast_ = slow_ = best_ncc;
     has_average_ = true;
   } else {
-    fast_ += options_.relocalize_alpha_fast * (best_log_likelihood - fast_);
-    slow_ += options_.relocalize_alpha_slow * (best_log_likelihood - slow_);
+    fast_ += options_.relocalize_alpha_fast * (best_ncc - fast_);
+    slow_ += options_.relocalize_alpha_slow * (best_ncc - slow_);
   }
-  const double drop = options_.relocalize_ncc_drop / sigma_;
-  relocalizing_ = fast_ < slow_ - drop;
+  // The persistence counts the updates themselves, not the fast average,
+  // which keeps one bad frame for several updates.
+  const double threshold = slow_ - options_.relocalize_ncc_drop;
+  dropped_run_ = best_ncc < threshold ? dropped_run_ + 1 : 0;
+  relocalizing_ =
+      fast_ < threshold && dropped_run_ >= options_.relocalize_min_updates;
   return relocalizing_;
 }
 

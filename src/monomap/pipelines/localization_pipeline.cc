@@ -32,6 +32,7 @@ nlohmann::json LocalizationReport::ToJson() const {
     steps_json.push_back({{"particles", s.particles},
                           {"ess", s.ess},
                           {"best_ncc", s.best_ncc},
+                          {"best_coverage", s.best_coverage},
                           {"mcc_accepted", s.mcc_accepted},
                           {"merged", s.merged},
                           {"injected", s.injected},
@@ -40,7 +41,8 @@ nlohmann::json LocalizationReport::ToJson() const {
                           {"refined", s.refined},
                           {"weigh_seconds", s.weigh_seconds},
                           {"mcc_seconds", s.mcc_seconds},
-                          {"seconds", s.seconds}});
+                          {"seconds", s.seconds},
+                          {"cpu_seconds", s.cpu_seconds}});
   }
   j["steps"] = steps_json;
   return j;
