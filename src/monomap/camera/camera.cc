@@ -6,6 +6,16 @@
 
 namespace monomap {
 
+std::optional<LensModel> LensModelFromName(const std::string& name) {
+  if (name == "plumb_bob") return LensModel::kPlumbBob;
+  if (name == "equidistant") return LensModel::kEquidistant;
+  return std::nullopt;
+}
+
+const char* LensModelName(LensModel model) {
+  return model == LensModel::kEquidistant ? "equidistant" : "plumb_bob";
+}
+
 bool Camera::HasDistortion() const {
   for (double d : distortion) {
     if (d != 0.0) return true;

@@ -1,9 +1,13 @@
-// Pinhole camera with plumb_bob (Brown-Conrady) distortion, the model of ROS
-// camera_info and OpenCV: k1, k2, k3 radial, p1, p2 tangential, applied to
-// normalized coordinates.
+// Pinhole camera with one of the two lens models of ROS camera_info:
+//   plumb_bob    (Brown-Conrady, OpenCV's default) k1, k2, k3 radial,
+//                p1, p2 tangential, applied to normalized coordinates;
+//   equidistant  (Kannala-Brandt fisheye, OpenCV's cv::fisheye) k1..k4:
+//                theta_d = theta (1 + k1 theta^2 + ... + k4 theta^8), with
+//                theta the angle of the ray to the optical axis.
 #pragma once
 
 #include <array>
+#include <optional>
 #include <string>
 
 #include <Eigen/Core>
@@ -11,11 +15,19 @@
 
 namespace monomap {
 
+enum class LensModel { kPlumbBob, kEquidistant };
+
+// The camera_info name ("plumb_bob", "equidistant"); nullopt for others.
+std::optional<LensModel> LensModelFromName(const std::string& name);
+const char* LensModelName(LensModel model);
+
 struct Camera {
   int width = 0;
   int height = 0;
   double fx = 0, fy = 0, cx = 0, cy = 0;
-  // k1, k2, p1, p2, k3 (OpenCV order).
+  LensModel model = LensModel::kPlumbBob;
+  // plumb_bob: k1, k2, p1, p2, k3 (OpenCV order); equidistant: k1, k2, k3,
+  // k4 and a 0.
   std::array<double, 5> distortion = {0, 0, 0, 0, 0};
 
   bool HasDistortion() const;

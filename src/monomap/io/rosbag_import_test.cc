@@ -292,9 +292,10 @@ TEST(RosbagImport, BadEncodingCalibrationAndLensNameTheField) {
             std::string::npos)
       << e;
   spec = {};
-  spec.distortion_model = "equidistant";
-  e = ImportError(WriteBag("fisheye.bag", spec), Options(spec));
-  EXPECT_NE(e.find("field 'distortion_model': 'equidistant' (fisheye) is not "
+  spec.distortion_model = "rational_polynomial";
+  e = ImportError(WriteBag("rational.bag", spec), Options(spec));
+  EXPECT_NE(e.find("rational.bag: topic '/cam/camera_info': field "
+                   "'distortion_model': 'rational_polynomial' is not "
                    "supported"),
             std::string::npos)
       << e;
