@@ -36,8 +36,10 @@ struct Camera {
   // Normalized undistorted (x/z, y/z) -> normalized distorted.
   Eigen::Vector2d Distort(const Eigen::Vector2d& xn) const;
   // Inverse of Distort by Gauss-Newton (converges for real lenses within
-  // the image).
+  // the image); for equidistant, Newton on the angle, which stays below
+  // kMaxEquidistantTheta.
   Eigen::Vector2d Undistort(const Eigen::Vector2d& xd) const;
+  static constexpr double kMaxEquidistantTheta = 1.5607;  // 89.4 degrees
 
   // Camera-frame point -> raw (distorted) pixel. Caller checks z > 0.
   Eigen::Vector2d ImageFromCam(const Eigen::Vector3d& x_in_cam) const;
@@ -56,12 +58,15 @@ struct Camera {
   // The same camera for images resized to new_width x new_height (pixel
   // centres convention: u' + 0.5 = s (u + 0.5)). Distortion is unchanged.
   Camera Scaled(int new_width, int new_height) const;
-  // The same intrinsics without distortion (for rendering and undistorted
-  // images).
+  // The same intrinsics without distortion, as plumb_bob (for rendering and
+  // undistorted images).
   Camera Pinhole() const;
 
   // Throws OptionsError naming the field if a value makes no sense.
   void Check() const;
+
+ private:
+  Eigen::Vector2d UndistortEquidistant(const Eigen::Vector2d& xd) const;
 };
 
 }  // namespace monomap
