@@ -227,5 +227,41 @@ TEST_F(MappingE2EHallway, NavGridWallsLieOnTheTrueWalls) {
   EXPECT_LE(f.free_outside_floor, 0.01);
 }
 
+// The lab corner seen through a fisheye (equidistant) lens: 320x240 with
+// 122 degrees of horizontal field of view. Tracking, triangulation, bundle
+// adjustment and texturing all go through the camera's own model, so the
+// map is as good as with the plumb_bob lens above.
+TEST(MappingE2EFisheye, LabCornerThroughAnEquidistantLens) {
+  SimulationOptions sim;
+  sim.world = "lab-corner";
+  sim.seed = 3;
+  sim.num_frames = 120;
+  sim.width = 320;
+  sim.height = 240;
+  sim.lens = "equidistant";
+  sim.focal_px_at_640 = 300.0;
+  sim.k1 = 0.02;
+  sim.k2 = -0.004;
+  sim.odometry.wheel_radius_error = 0.003;
+  sim.odometry.yaw_scale_error = 0.003;
+  const auto w = SimulateAndMap(sim, "lab_corner_fisheye");
+  EXPECT_EQ(w->result.map.camera.model, LensModel::kEquidistant);
+  EXPECT_EQ(ReadMap(w->dir / "structure").camera.model,
+            LensModel::kEquidistant);
+  const StructureAccuracy& a = w->accuracy;
+  EXPECT_GT(a.landmarks, 300);
+  EXPECT_LT(a.landmarks_off_structure, 0.1 * a.landmarks);
+  EXPECT_LT(a.point_error_all.relative_percent.median, 2.0);
+  const auto& ba = w->result.report.bundle_adjustment;
+  EXPECT_LT(ba.final_median_error_px, 0.7 * ba.initial_median_error_px);
+  const TruePlaneResult* floor =
+      FindTruePlane(*w, Eigen::Vector3d::UnitZ(), 0.0);
+  ASSERT_NE(floor, nullptr);
+  EXPECT_TRUE(floor->matched);
+  EXPECT_LT(floor->normal_error_deg, 1.0);
+  EXPECT_EQ(a.precision, 1.0);
+  fs::remove_all(w->dir);
+}
+
 }  // namespace
 }  // namespace monomap

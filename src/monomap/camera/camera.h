@@ -25,10 +25,11 @@ struct Camera {
   int width = 0;
   int height = 0;
   double fx = 0, fy = 0, cx = 0, cy = 0;
-  LensModel model = LensModel::kPlumbBob;
   // plumb_bob: k1, k2, p1, p2, k3 (OpenCV order); equidistant: k1, k2, k3,
   // k4 and a 0.
   std::array<double, 5> distortion = {0, 0, 0, 0, 0};
+  // Last, so that aggregate initializers of plumb_bob cameras stay valid.
+  LensModel model = LensModel::kPlumbBob;
 
   bool HasDistortion() const;
   Eigen::Matrix3d K() const;

@@ -17,6 +17,8 @@
 #include "monomap/geometry/rigid3.h"
 #include "monomap/io/bag_import.h"
 #include "monomap/io/dataset.h"
+#include "monomap/util/error.h"
+#include "monomap/util/file.h"
 
 namespace monomap::bag_test {
 
@@ -225,6 +227,50 @@ inline void CheckImportedDrive(const BagSpec& spec, const RosbagImportReport& r,
   } else {
     EXPECT_EQ(max_pixel_error, 0.0);
   }
+}
+
+// Runs `import(bag, out, o)` (ImportRosbag or ImportRosbag2), expected to
+// fail with InputError over a previous import in `out`; returns the message
+// and checks that the previous output is left as it was.
+template <typename Import>
+std::string ImportError(Import import, const std::filesystem::path& bag,
+                        const std::filesystem::path& out,
+                        const RosbagImportOptions& o) {
+  std::filesystem::remove_all(out);
+  MarkOutputDirectory(out, "dataset");  // a previous import
+  WriteFileAtomic(out / "marker", "old");
+  std::string message;
+  try {
+    import(bag, out, o);
+  } catch (const InputError& e) {
+    message = e.what();
+  }
+  EXPECT_TRUE(std::filesystem::exists(out / "marker"))
+      << "output replaced on error";
+  EXPECT_FALSE(std::filesystem::exists(out / "rgb.txt"));
+  EXPECT_FALSE(message.empty()) << "no InputError";
+  return message;
+}
+
+// Without /tf_static the import stops naming the frames; a mount file
+// gives the mount instead.
+template <typename Import>
+void CheckMissingMount(Import import, const std::filesystem::path& bag,
+                       const std::filesystem::path& dir) {
+  BagSpec spec;
+  spec.with_tf_static = false;
+  RosbagImportOptions o = Options(spec);
+  const std::string e = ImportError(import, bag, dir / "kept", o);
+  EXPECT_NE(e.find("topic '/tf_static': no transform from base frame "
+                   "'base_link' to camera frame 'camera_optical'"),
+            std::string::npos)
+      << e;
+  const Rigid3d mount = BaseFromCameraLink() * CameraLinkFromOptical();
+  WriteCameraMountYaml(dir / "mount.yaml", mount);
+  o.camera_mount = dir / "mount.yaml";
+  const RosbagImportReport r = import(bag, dir / "dataset", o);
+  EXPECT_LT(PoseError(r.base_from_cam, mount), 1e-9);
+  EXPECT_EQ(r.frames_written, 18);
 }
 
 }  // namespace monomap::bag_test

@@ -80,23 +80,8 @@ TEST(Rosbag2Import, ALoneDb3OrTheMetadataFileWorkToo) {
   EXPECT_EQ(r.frames_written, 18);
 }
 
-// Runs an import expected to fail; returns the message and checks that the
-// previous output is left as it was.
 std::string ImportError(const fs::path& bag, const RosbagImportOptions& o) {
-  const fs::path out = kDir / "kept";
-  fs::remove_all(out);
-  MarkOutputDirectory(out, "dataset");  // a previous import
-  WriteFileAtomic(out / "marker", "old");
-  std::string message;
-  try {
-    ImportRosbag2(bag, out, o);
-  } catch (const InputError& e) {
-    message = e.what();
-  }
-  EXPECT_TRUE(fs::exists(out / "marker")) << "output replaced on error";
-  EXPECT_FALSE(fs::exists(out / "rgb.txt"));
-  EXPECT_FALSE(message.empty()) << "no InputError";
-  return message;
+  return bag_test::ImportError(ImportRosbag2, bag, kDir / "kept", o);
 }
 
 #define EXPECT_HAS(text, part) \
@@ -203,17 +188,7 @@ TEST(Rosbag2Import, McapStorageAndNonCdrSerializationAreRefused) {
 TEST(Rosbag2Import, MissingMountIsAnErrorUnlessAFileGivesIt) {
   BagSpec spec;
   spec.with_tf_static = false;
-  const fs::path bag = WriteBag("nomount", spec);
-  RosbagImportOptions o = Options(spec);
-  EXPECT_HAS(ImportError(bag, o),
-             "topic '/tf_static': no transform from base frame 'base_link' "
-             "to camera frame 'camera_optical'");
-  const Rigid3d mount = BaseFromCameraLink() * CameraLinkFromOptical();
-  WriteCameraMountYaml(kDir / "mount.yaml", mount);
-  o.camera_mount = kDir / "mount.yaml";
-  const RosbagImportReport r = ImportRosbag2(bag, kDir / "dataset", o);
-  EXPECT_LT(PoseError(r.base_from_cam, mount), 1e-9);
-  EXPECT_EQ(r.frames_written, 18);
+  CheckMissingMount(ImportRosbag2, WriteBag("nomount", spec), kDir);
 }
 
 }  // namespace

@@ -104,22 +104,8 @@ TEST(RosbagImport, CompressedPngAndJpeg) {
   CheckImport(spec);
 }
 
-// Runs an import expected to fail; returns the message and checks that the
-// previous output is left as it was.
 std::string ImportError(const fs::path& bag, const RosbagImportOptions& o) {
-  const fs::path out = kDir / "kept";
-  fs::remove_all(out);
-  MarkOutputDirectory(out, "dataset");  // a previous import
-  WriteFileAtomic(out / "marker", "old");
-  std::string message;
-  try {
-    ImportRosbag(bag, out, o);
-  } catch (const InputError& e) {
-    message = e.what();
-  }
-  EXPECT_TRUE(fs::exists(out / "marker")) << "output replaced on error";
-  EXPECT_FALSE(fs::exists(out / "rgb.txt"));
-  return message;
+  return bag_test::ImportError(ImportRosbag, bag, kDir / "kept", o);
 }
 
 TEST(RosbagImport, MissingTopicListsTheBagsTopics) {
@@ -173,19 +159,7 @@ TEST(RosbagImport, BadEncodingCalibrationAndLensNameTheField) {
 TEST(RosbagImport, MissingMountIsAnErrorUnlessAFileGivesIt) {
   BagSpec spec;
   spec.with_tf_static = false;
-  const fs::path bag = WriteBag("nomount.bag", spec);
-  RosbagImportOptions o = Options(spec);
-  const std::string e = ImportError(bag, o);
-  EXPECT_NE(e.find("topic '/tf_static': no transform from base frame "
-                   "'base_link' to camera frame 'camera_optical'"),
-            std::string::npos)
-      << e;
-  const Rigid3d mount = BaseFromCameraLink() * CameraLinkFromOptical();
-  WriteCameraMountYaml(kDir / "mount.yaml", mount);
-  o.camera_mount = kDir / "mount.yaml";
-  const RosbagImportReport r = ImportRosbag(bag, kDir / "dataset", o);
-  EXPECT_LT(PoseError(r.base_from_cam, mount), 1e-9);
-  EXPECT_EQ(r.frames_written, 18);
+  CheckMissingMount(ImportRosbag, WriteBag("nomount.bag", spec), kDir);
 }
 
 }  // namespace
