@@ -78,21 +78,25 @@ const TruePlaneResult* FindTruePlane(const MappedWorld& w,
 
 // Lab corner at 320x240, 120 frames. The camera drives towards the walls:
 // little parallax on them, so only the floor is expected as a plane.
+SimulationOptions LabCorner() {
+  SimulationOptions sim;
+  sim.world = "lab-corner";
+  sim.seed = 3;
+  sim.num_frames = 120;
+  sim.width = 320;
+  sim.height = 240;
+  // Scale drift of the odometry is unobservable from one camera, so the
+  // map inherits it; a well-calibrated robot (0.3% systematic error)
+  // keeps the 1% accuracy target meaningful.
+  sim.odometry.wheel_radius_error = 0.003;
+  sim.odometry.yaw_scale_error = 0.003;
+  return sim;
+}
+
 class MappingE2E : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    SimulationOptions sim;
-    sim.world = "lab-corner";
-    sim.seed = 3;
-    sim.num_frames = 120;
-    sim.width = 320;
-    sim.height = 240;
-    // Scale drift of the odometry is unobservable from one camera, so the
-    // map inherits it; a well-calibrated robot (0.3% systematic error)
-    // keeps the 1% accuracy target meaningful.
-    sim.odometry.wheel_radius_error = 0.003;
-    sim.odometry.yaw_scale_error = 0.003;
-    world_ = SimulateAndMap(sim, "lab_corner").release();
+    world_ = SimulateAndMap(LabCorner(), "lab_corner").release();
   }
   static void TearDownTestSuite() {
     fs::remove_all(world_->dir);
@@ -232,19 +236,15 @@ TEST_F(MappingE2EHallway, NavGridWallsLieOnTheTrueWalls) {
 // adjustment and texturing all go through the camera's own model, so the
 // map is as good as with the plumb_bob lens above.
 TEST(MappingE2EFisheye, LabCornerThroughAnEquidistantLens) {
-  SimulationOptions sim;
-  sim.world = "lab-corner";
-  sim.seed = 3;
-  sim.num_frames = 120;
-  sim.width = 320;
-  sim.height = 240;
+  SimulationOptions sim = LabCorner();
   sim.lens = "equidistant";
   sim.focal_px_at_640 = 300.0;
   sim.k1 = 0.02;
   sim.k2 = -0.004;
-  sim.odometry.wheel_radius_error = 0.003;
-  sim.odometry.yaw_scale_error = 0.003;
   const auto w = SimulateAndMap(sim, "lab_corner_fisheye");
+  // Measured: floor normal 0.26 deg (plumb_bob lens above: 0.16), median
+  // depth error 0.60% (0.39%), on the floor 0.37% (0.23%): the fisheye
+  // has 40% fewer pixels per degree.
   EXPECT_EQ(w->result.map.camera.model, LensModel::kEquidistant);
   EXPECT_EQ(ReadMap(w->dir / "structure").camera.model,
             LensModel::kEquidistant);
