@@ -41,7 +41,8 @@ double EquidistantTheta(const std::array<double, 5>& k, double theta,
   const double poly = 1.0 + t2 * (k[0] + t2 * (k[1] + t2 * (k[2] + t2 * k[3])));
   if (derivative) {
     *derivative =
-        1.0 + t2 * (3 * k[0] + t2 * (5 * k[1] + t2 * (7 * k[2] + t2 * 9 * k[3])));
+        1.0 +
+        t2 * (3 * k[0] + t2 * (5 * k[1] + t2 * (7 * k[2] + t2 * 9 * k[3])));
   }
   return theta * poly;
 }

@@ -84,9 +84,9 @@ TEST(Camera, EquidistantAgreesWithOpenCvFisheye) {
   for (size_t i = 0; i < points.size(); ++i) {
     const Eigen::Vector3d x(points[i].x, points[i].y, points[i].z);
     const Eigen::Vector2d p = c.ImageFromCam(x);
-    worst_project = std::max(
-        worst_project, (p - Eigen::Vector2d(projected[i].x, projected[i].y))
-                           .norm());
+    worst_project =
+        std::max(worst_project,
+                 (p - Eigen::Vector2d(projected[i].x, projected[i].y)).norm());
     const Eigen::Vector2d xn = c.NormalizedFromImage(p);
     worst_unproject = std::max(
         worst_unproject,

@@ -13,10 +13,10 @@
 #include <string>
 
 #include "monomap/exe/commands.h"
+#include "monomap/io/bag_import.h"
 #include "monomap/io/standard_import.h"
 #include "monomap/util/error.h"
 #include "monomap/util/file.h"
-#include "monomap/io/bag_import.h"
 #ifdef MONOMAP_HAVE_ROSBAG
 #include "monomap/io/rosbag_import.h"
 #endif
@@ -39,10 +39,9 @@ RosbagImportReport ImportAnyBag(const std::filesystem::path& bag,
 #ifdef MONOMAP_HAVE_ROSBAG2
     return ImportRosbag2(bag, out, o);
 #else
-    throw Error(
-        "import rosbag: " + bag.string() +
-        " is a ROS 2 bag, and this monomap was built without ROS 2 bag "
-        "support (install libsqlite3-dev libfastcdr-dev and rebuild)");
+    throw Error("import rosbag: " + bag.string() +
+                " is a ROS 2 bag, and this monomap was built without ROS 2 bag "
+                "support (install libsqlite3-dev libfastcdr-dev and rebuild)");
 #endif
   }
 #ifdef MONOMAP_HAVE_ROSBAG
@@ -64,8 +63,7 @@ void RegisterRosbagImport(CLI::App* import) {
   auto bag = std::make_shared<std::string>();
   auto out = std::make_shared<std::string>();
   auto quiet = std::make_shared<bool>(false);
-  cmd->add_option("bag",
-                  *bag,
+  cmd->add_option("bag", *bag,
                   "ROS 1 .bag file, or ROS 2 bag directory (metadata.yaml + "
                   ".db3; or one .db3 file)")
       ->required();

@@ -66,9 +66,9 @@ Camera CameraFromInfo(const CameraInfo& info, const std::string& where) {
                                 : info.distortion_model;
   const std::optional<LensModel> lens = LensModelFromName(model);
   if (!lens) {
-    throw InputError(where, "distortion_model",
-                     "'" + model +
-                         "' is not supported (plumb_bob or equidistant)");
+    throw InputError(
+        where, "distortion_model",
+        "'" + model + "' is not supported (plumb_bob or equidistant)");
   }
   c.model = *lens;
   // plumb_bob: k1 k2 p1 p2 [k3]; equidistant: k1 k2 k3 k4.
@@ -266,7 +266,8 @@ DecodedImage DecodeRaw(const Image& msg, const std::string& where) {
 DecodedImage DecodeCompressed(const Image& msg, const std::string& where) {
   DecodedImage d;
   d.encoding = "compressed " + msg.encoding;
-  if (!msg.data.empty()) d.pixels = cv::imdecode(msg.data, cv::IMREAD_UNCHANGED);
+  if (!msg.data.empty())
+    d.pixels = cv::imdecode(msg.data, cv::IMREAD_UNCHANGED);
   if (d.pixels.empty()) {
     throw InputError(
         where, "data",
@@ -422,8 +423,7 @@ RosbagImportReport ImportBag(BagMessages& bag, const fs::path& out_dir,
       [](const ImportedFrame& f) { return f.odometry_base.has_value(); });
   WriteImportedDataset(
       out.path(), s.camera, s.frames,
-      planar ? std::optional<Rigid3d>(s.base_from_cam) : std::nullopt,
-      s.name);
+      planar ? std::optional<Rigid3d>(s.base_from_cam) : std::nullopt, s.name);
   out.Commit();
   RosbagImportReport& r = s.report;
   r.frames_written = static_cast<int>(s.frames.size());

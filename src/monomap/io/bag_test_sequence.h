@@ -86,7 +86,7 @@ struct BagSpec {
   std::string encoding = "mono8";  // or rgb8, bgr8, jpeg, png, 16UC1
   bool odom_as_tf = false;
   bool with_tf_static = true;
-  bool fisheye = false;  // an equidistant camera_info
+  bool fisheye = false;          // an equidistant camera_info
   std::string distortion_model;  // overrides the camera's when set
   bool calibrated = true;
 };

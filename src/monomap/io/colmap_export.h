@@ -77,8 +77,8 @@ struct ColmapExportReport {
 // k3 k4) for an equidistant lens.
 ColmapModel::Camera ColmapCameraFromCamera(const Camera& camera, int id = 1);
 // Back from SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL, RADIAL, OPENCV,
-// OPENCV_FISHEYE and FULL_OPENCV with k4 = k5 = k6 = 0. Throws InputError naming the model
-// for any other camera.
+// OPENCV_FISHEYE and FULL_OPENCV with k4 = k5 = k6 = 0. Throws InputError
+// naming the model for any other camera.
 Camera CameraFromColmapCamera(const ColmapModel::Camera& camera);
 
 // Builds the model: the map's camera; one image per trajectory pose (id =

@@ -242,9 +242,9 @@ Camera ReadCameraYamlNodes(const fs::path& path) {
     if (m != "none" && !m.empty()) {
       const auto lens = LensModelFromName(m);
       if (!lens) {
-        throw InputError(path.string(), "distortion_model",
-                         "'" + m +
-                             "' is not supported (plumb_bob or equidistant)");
+        throw InputError(
+            path.string(), "distortion_model",
+            "'" + m + "' is not supported (plumb_bob or equidistant)");
       }
       c.model = *lens;
     }

@@ -24,12 +24,13 @@ class Reader {
     // Byte 0 is 0, byte 1 the kind: 0 CDR big-endian, 1 CDR little-endian
     // (what ROS 2 writes); 2/3 are parameter lists, others XCDR2.
     if (size < 4 || data[0] != 0 || data[1] > 1) {
-      throw InputError(
-          where_, "encapsulation",
-          size < 4 ? "message of " + std::to_string(size) + " bytes is "
-                                                            "truncated"
-                   : "kind " + std::to_string(data[0] * 256 + data[1]) +
-                         " is not plain CDR (0 or 1)");
+      throw InputError(where_, "encapsulation",
+                       size < 4
+                           ? "message of " + std::to_string(size) +
+                                 " bytes is "
+                                 "truncated"
+                           : "kind " + std::to_string(data[0] * 256 + data[1]) +
+                                 " is not plain CDR (0 or 1)");
     }
     try {
       cdr_.read_encapsulation();  // sets the endianness, resets alignment
@@ -57,8 +58,9 @@ class Reader {
     if (n > Remaining() / sizeof(T)) {
       throw InputError(where_, field,
                        "sequence of " + std::to_string(n) + " elements but " +
-                           std::to_string(Remaining()) + " bytes left "
-                                                         "(truncated?)");
+                           std::to_string(Remaining()) +
+                           " bytes left "
+                           "(truncated?)");
     }
     std::vector<T> v(n);
     if (n > 0) cdr_.deserializeArray(v.data(), n);
@@ -109,8 +111,8 @@ auto Decode(const uint8_t* data, size_t size, const std::string& where,
     return decode(r);
   } catch (const cdr::exception::Exception& e) {
     throw InputError(where, r.Field(),
-                     "truncated or corrupt message (" +
-                         std::to_string(size) + " bytes): " + e.what());
+                     "truncated or corrupt message (" + std::to_string(size) +
+                         " bytes): " + e.what());
   }
 }
 
@@ -176,8 +178,8 @@ std::vector<bag::Transform> DecodeTfMessage(const uint8_t* data, size_t size,
   });
 }
 
-bag::Transform DecodeOdometry(const uint8_t* data, size_t size,
-                              double recorded, const std::string& where) {
+bag::Transform DecodeOdometry(const uint8_t* data, size_t size, double recorded,
+                              const std::string& where) {
   return Decode(data, size, where, [&](Reader& r) {
     bag::Transform t;
     t.stamp = r.Header(recorded, &t.parent);

@@ -30,7 +30,7 @@ std::vector<bag::Transform> DecodeTfMessage(const uint8_t* data, size_t size,
                                             const std::string& where);
 // nav_msgs/msg/Odometry: the pose (parent = header.frame_id, child =
 // child_frame_id).
-bag::Transform DecodeOdometry(const uint8_t* data, size_t size,
-                              double recorded, const std::string& where);
+bag::Transform DecodeOdometry(const uint8_t* data, size_t size, double recorded,
+                              const std::string& where);
 
 }  // namespace monomap::ros2

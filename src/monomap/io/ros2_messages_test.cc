@@ -32,8 +32,7 @@ TEST(Ros2Messages, OdometryInBothByteOrders) {
     EXPECT_NEAR(t.stamp, 12.75, 1e-9);
     EXPECT_LT((t.parent_from_child.translation - pose.translation).norm(),
               1e-12);
-    EXPECT_LT(AngleBetween(t.parent_from_child.rotation, pose.rotation),
-              1e-9);
+    EXPECT_LT(AngleBetween(t.parent_from_child.rotation, pose.rotation), 1e-9);
   }
 }
 

@@ -78,8 +78,7 @@ BagFiles FindFiles(const fs::path& path) {
   if (path.extension() == ".db3" && fs::is_regular_file(path)) {
     return {path.string(), {path}};
   }
-  const fs::path yaml =
-      fs::is_directory(path) ? path / "metadata.yaml" : path;
+  const fs::path yaml = fs::is_directory(path) ? path / "metadata.yaml" : path;
   if (!fs::is_regular_file(yaml)) {
     throw InputError(yaml.string() +
                      ": file not found (a ROS 2 bag directory holds "
@@ -96,8 +95,8 @@ class Db3 {
         SQLITE_OK) {
       const std::string message = db_ ? sqlite3_errmsg(db_) : "out of memory";
       sqlite3_close(db_);
-      throw InputError(path_ + ": cannot open the ROS 2 bag storage: " +
-                       message);
+      throw InputError(path_ +
+                       ": cannot open the ROS 2 bag storage: " + message);
     }
   }
   ~Db3() { sqlite3_close(db_); }
@@ -226,9 +225,9 @@ class Ros2Messages : public bag::BagMessages {
       if (it == f.topics.end()) continue;
       const std::string where = f.db->path() + ": topic '" + topic + "'";
       if (it->second.serialization_format != "cdr") {
-        throw InputError(where, "serialization_format",
-                         "'" + it->second.serialization_format +
-                             "' is not supported (cdr)");
+        throw InputError(
+            where, "serialization_format",
+            "'" + it->second.serialization_format + "' is not supported (cdr)");
       }
       bool go_on = true;
       f.db->Query(

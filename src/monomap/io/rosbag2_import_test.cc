@@ -1,8 +1,7 @@
 #include "monomap/io/rosbag2_import.h"
 
-#include <unistd.h>
-
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include "monomap/io/bag_test_sequence.h"
 #include "monomap/io/rosbag2_test_bag.h"

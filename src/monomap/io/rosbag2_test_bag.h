@@ -49,10 +49,9 @@ class CdrWriter {
   }
   void Doubles(const double* v, size_t n) { cdr_.serializeArray(v, n); }
   void Pose(const Rigid3d& t) {
-    const double v[7] = {t.translation.x(), t.translation.y(),
-                         t.translation.z(), t.rotation.x(),
-                         t.rotation.y(),    t.rotation.z(),
-                         t.rotation.w()};
+    const double v[7] = {
+        t.translation.x(), t.translation.y(), t.translation.z(), t.rotation.x(),
+        t.rotation.y(),    t.rotation.z(),    t.rotation.w()};
     Doubles(v, 7);
   }
   std::string Data() {
@@ -119,14 +118,15 @@ class Ros2BagWriter {
     const double f = calibrated ? 1.0 : 0.0;
     const double k[9] = {f * c.fx, 0, c.cx, 0, f * c.fy, c.cy, 0, 0, 1};
     const double r[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
-    const double p[12] = {f * c.fx, 0, c.cx, 0, 0, f * c.fy, c.cy, 0, 0, 0, 1, 0};
+    const double p[12] = {f * c.fx, 0, c.cx, 0, 0, f * c.fy,
+                          c.cy,     0, 0,    0, 1, 0};
     w.Doubles(k, 9);
     w.Doubles(r, 9);
     w.Doubles(p, 12);
     // binning_x, binning_y, roi (x_offset, y_offset, height, width,
     // do_rectify).
-    w << uint32_t(0) << uint32_t(0) << uint32_t(0) << uint32_t(0)
-      << uint32_t(0) << uint32_t(0) << false;
+    w << uint32_t(0) << uint32_t(0) << uint32_t(0) << uint32_t(0) << uint32_t(0)
+      << uint32_t(0) << false;
     Write(topic, "sensor_msgs/msg/CameraInfo", t, w.Data());
   }
   void Tf(const std::string& topic, double recorded, double stamp,
@@ -157,8 +157,8 @@ class Ros2BagWriter {
     const uint32_t step = image.cols * image.elemSize();
     CdrWriter w;
     w.Header(t, frame);
-    w << uint32_t(image.rows) << uint32_t(image.cols) << encoding
-      << uint8_t(0) << step;
+    w << uint32_t(image.rows) << uint32_t(image.cols) << encoding << uint8_t(0)
+      << step;
     w.Bytes(std::vector<uint8_t>(pixels.data, pixels.data + step * image.rows));
     Write(topic, "sensor_msgs/msg/Image", t, w.Data());
   }

@@ -1,8 +1,7 @@
 #include "monomap/io/rosbag_import.h"
 
-#include <unistd.h>
-
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <fstream>
 

@@ -272,8 +272,8 @@ TEST(BundleAdjustmentTest, FisheyeLensAdjustsAndRefines) {
   Camera wrong = fisheye;
   wrong.distortion[0] += 0.03;
   ba.refine_distortion = true;
-  const Errors refined = AdjustWithLens(scene, wrong, scene.tracks, odometry,
-                                        ba, &refined_report);
+  const Errors refined =
+      AdjustWithLens(scene, wrong, scene.tracks, odometry, ba, &refined_report);
   // k1..k4 trade off against each other: compare what the lenses do, the
   // pixel where each images the true ray of a pixel, over the region the
   // tracks cover (440 x 360 px about the centre).

@@ -43,16 +43,16 @@ inline void DistortEquidistant(const D* k, const T& x, const T& y, T* xd,
     const T r = sqrt(r2);
     const T theta = atan(r);
     const T t2 = theta * theta;
-    scale = theta * (1.0 + t2 * (k[0] + t2 * (k[1] + t2 * (k[2] + t2 * k[3])))) /
-            r;
+    scale =
+        theta * (1.0 + t2 * (k[0] + t2 * (k[1] + t2 * (k[2] + t2 * k[3])))) / r;
   }
   *xd = x * scale;
   *yd = y * scale;
 }
 
 // Camera-frame point -> raw pixel (px[0], px[1]) with the five distortion
-// coefficients of the camera's lens model given apart (double, or ceres::Jet when
-// bundle adjustment refines them). Caller checks z > 0.
+// coefficients of the camera's lens model given apart (double, or ceres::Jet
+// when bundle adjustment refines them). Caller checks z > 0.
 template <typename T, typename D>
 inline void ProjectWithDistortion(const Intrinsics& in, const D* distortion,
                                   const T* x_in_cam, T* px) {
