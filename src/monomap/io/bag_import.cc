@@ -41,6 +41,35 @@ std::string CanonicalType(const std::string& type) {
                                   : type.substr(0, msg) + type.substr(msg + 4);
 }
 
+namespace {
+
+// The lens of camera_info: distortion_model and D.
+void SetLens(const CameraInfo& info, const std::string& where, Camera* c) {
+  const bool no_distortion = std::all_of(info.d.begin(), info.d.end(),
+                                         [](double d) { return d == 0; });
+  const std::string model = info.distortion_model.empty() && no_distortion
+                                ? "plumb_bob"
+                                : info.distortion_model;
+  const std::optional<LensModel> lens = LensModelFromName(model);
+  if (!lens) {
+    throw InputError(
+        where, "distortion_model",
+        "'" + model + "' is not supported (plumb_bob or equidistant)");
+  }
+  c->model = *lens;
+  // plumb_bob: k1 k2 p1 p2 [k3]; equidistant: k1 k2 k3 k4.
+  const size_t n = info.d.size();
+  const bool plumb_bob = c->model == LensModel::kPlumbBob;
+  if (!(n == 0 || n == 4 || (plumb_bob && n == 5))) {
+    throw InputError(where, "D",
+                     model + " needs " + (plumb_bob ? "4 or 5" : "4") +
+                         " coefficients, got " + std::to_string(n));
+  }
+  std::copy(info.d.begin(), info.d.end(), c->distortion.begin());
+}
+
+}  // namespace
+
 Camera CameraFromInfo(const CameraInfo& info, const std::string& where) {
   if (info.k[0] <= 0 || info.k[4] <= 0) {
     throw InputError(where, "K",
@@ -59,30 +88,7 @@ Camera CameraFromInfo(const CameraInfo& info, const std::string& where) {
   c.cx = info.k[2];
   c.fy = info.k[4];
   c.cy = info.k[5];
-  const bool no_distortion = std::all_of(info.d.begin(), info.d.end(),
-                                         [](double d) { return d == 0; });
-  const std::string model = info.distortion_model.empty() && no_distortion
-                                ? "plumb_bob"
-                                : info.distortion_model;
-  const std::optional<LensModel> lens = LensModelFromName(model);
-  if (!lens) {
-    throw InputError(
-        where, "distortion_model",
-        "'" + model + "' is not supported (plumb_bob or equidistant)");
-  }
-  c.model = *lens;
-  // plumb_bob: k1 k2 p1 p2 [k3]; equidistant: k1 k2 k3 k4.
-  const size_t n = info.d.size();
-  const bool count_ok = c.model == LensModel::kPlumbBob
-                            ? n == 0 || n == 4 || n == 5
-                            : n == 0 || n == 4;
-  if (!count_ok) {
-    throw InputError(where, "D",
-                     model + " needs " +
-                         (c.model == LensModel::kPlumbBob ? "4 or 5" : "4") +
-                         " coefficients, got " + std::to_string(n));
-  }
-  std::copy(info.d.begin(), info.d.end(), c.distortion.begin());
+  SetLens(info, where, &c);
   try {
     c.Check();
   } catch (const OptionsError& e) {

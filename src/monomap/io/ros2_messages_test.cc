@@ -36,6 +36,34 @@ TEST(Ros2Messages, OdometryInBothByteOrders) {
   }
 }
 
+// The same, laid out by hand byte by byte as the CDR rules say (not by
+// fastcdr): little-endian, strings as uint32 length with the terminating
+// 0, doubles aligned to 8 bytes counted from after the 4-byte header.
+TEST(Ros2Messages, OdometryLaidOutByHand) {
+  std::string b("\0\1\0\0", 4);  // encapsulation CDR_LE, options 0
+  const auto put = [&b](const void* p, size_t n) {
+    b.append(static_cast<const char*>(p), n);
+  };
+  const int32_t sec = 7;
+  const uint32_t nanosec = 500000000, parent_len = 4, child_len = 2;
+  put(&sec, 4);          // offset 0 (after the header)
+  put(&nanosec, 4);      // 4
+  put(&parent_len, 4);   // 8
+  put("odm\0", 4);       // 12
+  put(&child_len, 4);    // 16
+  put("b\0", 2);         // 20
+  b.append(2, '\0');     // 22: padding to 24, a multiple of 8
+  const double pose[7] = {1.5, -2.25, 0.125, 0.0, 0.0, 0.6, 0.8};
+  put(pose, sizeof(pose));  // 24
+  const bag::Transform t = DecodeOdometry(Bytes(b), b.size(), 0, "x");
+  EXPECT_EQ(t.parent, "odm");
+  EXPECT_EQ(t.child, "b");
+  EXPECT_DOUBLE_EQ(t.stamp, 7.5);
+  EXPECT_EQ(t.parent_from_child.translation, Eigen::Vector3d(1.5, -2.25, 0.125));
+  EXPECT_NEAR(t.parent_from_child.rotation.z(), 0.6, 1e-15);
+  EXPECT_NEAR(t.parent_from_child.rotation.w(), 0.8, 1e-15);
+}
+
 TEST(Ros2Messages, ZeroStampFallsBackToTheRecordingTime) {
   CdrWriter w;
   w.Header(0.0, "cam");

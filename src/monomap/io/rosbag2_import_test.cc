@@ -156,6 +156,11 @@ TEST(Rosbag2Import, BadEncodingCalibrationAndLensNameTheField) {
   EXPECT_HAS(ImportError(WriteBag("rational", spec), Options(spec)),
              "rational: topic '/cam/camera_info': field 'distortion_model': "
              "'rational_polynomial' is not supported");
+  spec = {};
+  spec.distortion_model = "equidistant";  // with plumb_bob's 5 numbers
+  EXPECT_HAS(ImportError(WriteBag("five", spec), Options(spec)),
+             "five: topic '/cam/camera_info': field 'D': equidistant needs 4 "
+             "coefficients, got 5");
 }
 
 TEST(Rosbag2Import, McapStorageAndNonCdrSerializationAreRefused) {
