@@ -254,32 +254,21 @@ TEST(MapFormatTest, InvalidFieldsAreNamed) {
     std::vector<std::string> needles;
   };
   const std::vector<Case> cases = {
-      {"format",
-       [](json& j) { j["format"] = "monomap.mesh"; },
+      {"format", [](json& j) { j["format"] = "monomap.mesh"; },
        {"map.json: field 'format'", "monomap.mesh"}},
-      {"version2",
-       [](json& j) { j["version"] = 2; },
+      {"version2", [](json& j) { j["version"] = 2; },
        {"map.json: field 'version'", "unsupported version 2"}},
-      {"version_string",
-       [](json& j) { j["version"] = "1"; },
+      {"version_string", [](json& j) { j["version"] = "1"; },
        {"field 'version'", "integer"}},
-      {"no_normal",
-       [](json& j) { j["planes"][1].erase("normal"); },
+      {"no_normal", [](json& j) { j["planes"][1].erase("normal"); },
        {"map.json: field 'planes[1].normal': missing"}},
       {"long_normal",
-       [](json& j) {
-         j["planes"][0]["normal"] = {0.0, 0.0, 1.01};
-       },
+       [](json& j) { j["planes"][0]["normal"] = {0.0, 0.0, 1.01}; },
        {"map.json: field 'planes[0].normal'", "unit length"}},
-      {"short_normal",
-       [](json& j) {
-         j["planes"][0]["normal"] = {0.0, 1.0};
-       },
+      {"short_normal", [](json& j) { j["planes"][0]["normal"] = {0.0, 1.0}; },
        {"field 'planes[0].normal'", "expected 3 numbers, got 2"}},
       {"u_off_plane",
-       [](json& j) {
-         j["planes"][0]["u_axis"] = {0.0, 0.6, 0.8};
-       },
+       [](json& j) { j["planes"][0]["u_axis"] = {0.0, 0.6, 0.8}; },
        {"field 'planes[0].u_axis'", "not in the plane"}},
       {"v_not_orthogonal",
        [](json& j) {
@@ -289,22 +278,15 @@ TEST(MapFormatTest, InvalidFieldsAreNamed) {
        },
        {"field 'planes[0].v_axis'", "not orthogonal"}},
       {"origin_off_plane",
-       [](json& j) {
-         j["planes"][0]["origin"] = {0.0, 0.0, 0.01};
-       },
+       [](json& j) { j["planes"][0]["origin"] = {0.0, 0.0, 0.01}; },
        {"field 'planes[0].origin'", "not on the plane"}},
-      {"zero_ppm",
-       [](json& j) { j["planes"][1]["pixels_per_meter"] = 0; },
+      {"zero_ppm", [](json& j) { j["planes"][1]["pixels_per_meter"] = 0; },
        {"field 'planes[1].pixels_per_meter'", "positive"}},
       {"bad_polygon",
-       [](json& j) {
-         j["planes"][1]["polygon"][2] = {0.5, "x"};
-       },
+       [](json& j) { j["planes"][1]["polygon"][2] = {0.5, "x"}; },
        {"field 'planes[1].polygon[2][1]'", "expected a number"}},
       {"bad_feature",
-       [](json& j) {
-         j["planes"][0]["features"][1]["xyz"] = {1, 2, 3, 4};
-       },
+       [](json& j) { j["planes"][0]["features"][1]["xyz"] = {1, 2, 3, 4}; },
        {"field 'planes[0].features[1].xyz'", "expected 3 numbers"}},
       {"feature_id",
        [](json& j) { j["planes"][0]["features"][0]["id"] = 1.5; },
@@ -312,26 +294,19 @@ TEST(MapFormatTest, InvalidFieldsAreNamed) {
       {"texture_path",
        [](json& j) { j["planes"][0]["texture"] = "../plane_0.png"; },
        {"field 'planes[0].texture'", "plain file name"}},
-      {"duplicate_id",
-       [](json& j) { j["planes"][1]["id"] = 0; },
+      {"duplicate_id", [](json& j) { j["planes"][1]["id"] = 0; },
        {"field 'planes[1].id'", "duplicate"}},
-      {"camera",
-       [](json& j) { j["camera"]["fx"] = -1; },
+      {"camera", [](json& j) { j["camera"]["fx"] = -1; },
        {"field 'camera.fx'", "positive"}},
-      {"lens",
-       [](json& j) { j["camera"]["model"] = "fov"; },
+      {"lens", [](json& j) { j["camera"]["model"] = "fov"; },
        {"field 'camera.model'", "'fov' is not supported"}},
-      {"distortion",
-       [](json& j) { j["camera"]["distortion"] = {0.1}; },
+      {"distortion", [](json& j) { j["camera"]["distortion"] = {0.1}; },
        {"field 'camera.distortion'", "expected 5"}},
-      {"no_planes",
-       [](json& j) { j.erase("planes"); },
+      {"no_planes", [](json& j) { j.erase("planes"); },
        {"field 'planes': missing"}},
-      {"num_frames",
-       [](json& j) { j["num_frames"] = 5; },
+      {"num_frames", [](json& j) { j["num_frames"] = 5; },
        {"trajectory.txt", "num_frames is 5"}},
-      {"num_landmarks",
-       [](json& j) { j["num_landmarks"] = 13; },
+      {"num_landmarks", [](json& j) { j["num_landmarks"] = 13; },
        {"points.ply", "num_landmarks is 13"}},
   };
   for (const Case& c : cases) {
