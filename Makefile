@@ -12,7 +12,7 @@ DEB_PACKAGES = cmake ninja-build g++ pkg-config libopencv-dev libeigen3-dev \
   libtinygltf-dev libstb-dev libgtest-dev libgmock-dev libbenchmark-dev \
   colmap help2man \
   librosbag-dev libsensor-msgs-dev libnav-msgs-dev libtf2-msgs-dev \
-  libgeometry-msgs-dev \
+  libgeometry-msgs-dev libsqlite3-dev libfastcdr-dev \
   libjs-three libjs-chart.js
 
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)

@@ -15,6 +15,7 @@
 #include "monomap/io/rosbag_import.h"
 #include "monomap/io/rosbag_test_bag.h"
 #include "monomap/sim/simulate.h"
+#include "tests/import_check.h"
 #include "tests/monomap_cli.h"
 
 namespace monomap {
@@ -26,11 +27,6 @@ using test::RunResult;
 
 const fs::path kRoot = fs::temp_directory_path() /
                        ("monomap_import_e2e_" + std::to_string(getpid()));
-
-double PoseError(const Rigid3d& a, const Rigid3d& b) {
-  return (a.translation - b.translation).norm() +
-         AngleBetween(a.rotation, b.rotation);
-}
 
 // Writes the simulated dataset as a robot would have logged it: images,
 // camera_info, nav_msgs/Odometry of the base, /tf_static base -> camera.
@@ -58,19 +54,9 @@ fs::path WriteBagOf(const Dataset& sim) {
   return path;
 }
 
-// A short simulated hallway run (25 frames, 160x120) in kRoot/sim.
 Dataset SimulateHallway() {
   fs::remove_all(kRoot);
-  SimulationOptions so;
-  so.world = "hallway";
-  so.num_frames = 25;
-  so.width = 160;
-  so.height = 120;
-  so.write_structure = false;
-  Simulate(so, kRoot / "sim");
-  DatasetOptions no_gt;
-  no_gt.load_groundtruth = false;
-  return LoadDataset(kRoot / "sim", no_gt);
+  return test::SimulateHallway(kRoot / "sim");
 }
 
 TEST(ImportE2e, SimulatedHallwayRoundTripsThroughARosbag) {
@@ -87,35 +73,7 @@ TEST(ImportE2e, SimulatedHallwayRoundTripsThroughARosbag) {
   EXPECT_EQ(r.dropped_outside_odometry + r.dropped_in_gap, 0);
   EXPECT_TRUE(r.planar);
 
-  const Dataset imported = LoadDataset(kRoot / "imported");
-  ASSERT_EQ(imported.frames.size(), sim.frames.size());
-  EXPECT_LT(PoseError(*imported.base_from_cam, *sim.base_from_cam), 1e-9);
-  EXPECT_EQ(imported.camera.width, sim.camera.width);
-  EXPECT_NEAR(imported.camera.fx, sim.camera.fx, 1e-9);
-  EXPECT_NEAR(imported.camera.distortion[0], sim.camera.distortion[0], 1e-9);
-  double max_pose = 0, max_base = 0, max_dt = 0, max_pixel = 0;
-  for (size_t i = 0; i < sim.frames.size(); ++i) {
-    const DatasetFrame& a = sim.frames[i];
-    const DatasetFrame& b = imported.frames[i];
-    max_dt = std::max(max_dt, std::abs(a.timestamp - b.timestamp));
-    max_pose = std::max(max_pose, PoseError(a.odometry_world_from_cam,
-                                            b.odometry_world_from_cam));
-    max_base = std::max(
-        max_base,
-        std::abs(a.odometry_base->x - b.odometry_base->x) +
-            std::abs(a.odometry_base->y - b.odometry_base->y) +
-            std::abs(std::remainder(a.odometry_base->yaw - b.odometry_base->yaw,
-                                    2 * M_PI)));
-    cv::Mat diff;
-    cv::absdiff(sim.LoadImage(i, true), imported.LoadImage(i, true), diff);
-    double worst = 0;
-    cv::minMaxLoc(diff.reshape(1), nullptr, &worst);
-    max_pixel = std::max(max_pixel, worst);
-  }
-  EXPECT_LT(max_dt, 1e-6);
-  EXPECT_LT(max_pose, 1e-6);
-  EXPECT_LT(max_base, 1e-6);
-  EXPECT_EQ(max_pixel, 0.0);
+  test::ExpectSameDataset(sim, LoadDataset(kRoot / "imported"));
   fs::remove_all(kRoot);
 }
 

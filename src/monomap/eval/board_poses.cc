@@ -97,6 +97,10 @@ std::optional<BoardPose> EstimateBoardPose(const cv::Mat& grey,
                                            const Rigid3d& hint_world_from_cam,
                                            const BoardPoseOptions& options) {
   options.Check();
+  // OpenCV's solvePnP below knows the plumb_bob polynomial only.
+  CheckOption(camera.model == LensModel::kPlumbBob, "camera.distortion_model",
+              "board poses need a plumb_bob camera (equidistant is not "
+              "supported here)");
   const std::optional<std::vector<cv::Point2f>> detected =
       DetectCheckerboardCorners(grey, spec.inner_corners_x,
                                 spec.inner_corners_y,

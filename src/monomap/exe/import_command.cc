@@ -1,4 +1,5 @@
-// monomap import rosbag BAG -o DATASET --image-topic T --camera-info-topic T
+// monomap import rosbag BAG|BAGDIR -o DATASET --image-topic T
+//   --camera-info-topic T
 //   (--odom-topic T | --odom-tf odom:base_link) [--base-frame F] ...
 // monomap import euroc DIR -o DATASET, monomap import kitti SEQ -o DATASET
 // monomap import video FILE -o DATASET --camera YAML --odometry FILE
@@ -12,27 +13,62 @@
 #include <string>
 
 #include "monomap/exe/commands.h"
+#include "monomap/io/bag_import.h"
 #include "monomap/io/standard_import.h"
 #include "monomap/util/error.h"
 #include "monomap/util/file.h"
 #ifdef MONOMAP_HAVE_ROSBAG
 #include "monomap/io/rosbag_import.h"
 #endif
+#ifdef MONOMAP_HAVE_ROSBAG2
+#include "monomap/io/rosbag2_import.h"
+#endif
 
 namespace monomap {
 namespace {
 
+// A directory, a metadata.yaml or a .db3 is a ROS 2 bag; anything else is
+// read as a ROS 1 bag.
+RosbagImportReport ImportAnyBag(const std::filesystem::path& bag,
+                                const std::filesystem::path& out,
+                                const RosbagImportOptions& o) {
+  const bool ros2 = std::filesystem::is_directory(bag) ||
+                    bag.extension() == ".db3" ||
+                    bag.filename() == "metadata.yaml";
+  if (ros2) {
+#ifdef MONOMAP_HAVE_ROSBAG2
+    return ImportRosbag2(bag, out, o);
+#else
+    throw Error("import rosbag: " + bag.string() +
+                " is a ROS 2 bag, and this monomap was built without ROS 2 bag "
+                "support (install libsqlite3-dev libfastcdr-dev and rebuild)");
+#endif
+  }
+#ifdef MONOMAP_HAVE_ROSBAG
+  return ImportRosbag(bag, out, o);
+#else
+  throw Error(
+      "import rosbag: " + bag.string() +
+      " is a ROS 1 bag, and this monomap was built without ROS 1 bag support "
+      "(install librosbag-dev libsensor-msgs-dev libnav-msgs-dev "
+      "libtf2-msgs-dev libgeometry-msgs-dev and rebuild)");
+#endif
+}
+
 void RegisterRosbagImport(CLI::App* import) {
   CLI::App* cmd = import->add_subcommand(
       "rosbag",
-      "ROS 1 bag: images, CameraInfo, Odometry or tf, mount from /tf_static");
+      "ROS 1 bag or ROS 2 bag (sqlite3): images, CameraInfo, Odometry or tf, "
+      "mount from /tf_static");
   auto bag = std::make_shared<std::string>();
   auto out = std::make_shared<std::string>();
   auto quiet = std::make_shared<bool>(false);
-  cmd->add_option("bag", *bag, "ROS 1 bag file")->required();
+  cmd->add_option("bag", *bag,
+                  "ROS 1 .bag file, or ROS 2 bag directory (metadata.yaml + "
+                  ".db3; or one .db3 file)")
+      ->required();
   cmd->add_option("-o,--output", *out, "Dataset directory to write")
       ->required();
-#ifdef MONOMAP_HAVE_ROSBAG
   auto o = std::make_shared<RosbagImportOptions>();
   cmd->add_option("--image-topic", o->image_topic,
                   "sensor_msgs/Image or CompressedImage topic")
@@ -66,7 +102,7 @@ void RegisterRosbagImport(CLI::App* import) {
       throw OptionsError("import rosbag: give --odom-topic or --odom-tf");
     }
     CheckOutputDirectory(*out, "dataset", {*bag});
-    const RosbagImportReport r = ImportRosbag(*bag, *out, *o);
+    const RosbagImportReport r = ImportAnyBag(*bag, *out, *o);
     if (*quiet) return;
     std::fprintf(stderr,
                  "monomap: %s: %d of %d images imported (%s), %d dropped "
@@ -80,14 +116,6 @@ void RegisterRosbagImport(CLI::App* import) {
                           : "6-DoF odometry only",
                  out->c_str());
   });
-#else
-  cmd->callback([]() {
-    throw Error(
-        "import rosbag: this monomap was built without ROS 1 bag support "
-        "(install librosbag-dev libsensor-msgs-dev libnav-msgs-dev "
-        "libtf2-msgs-dev libgeometry-msgs-dev and rebuild)");
-  });
-#endif
 }
 
 // Odometry file or simulated odometry, and the pose gap: the same for

@@ -42,7 +42,8 @@ void AppendNumbers(std::initializer_list<double> values, std::string* out) {
 int NumParams(const std::string& model) {
   static const std::map<std::string, int> kParams = {
       {"SIMPLE_PINHOLE", 3}, {"PINHOLE", 4}, {"SIMPLE_RADIAL", 4},
-      {"RADIAL", 5},         {"OPENCV", 8},  {"FULL_OPENCV", 12}};
+      {"RADIAL", 5},         {"OPENCV", 8},  {"FULL_OPENCV", 12},
+      {"OPENCV_FISHEYE", 8}};
   const auto it = kParams.find(model);
   return it == kParams.end() ? -1 : it->second;
 }
@@ -334,7 +335,11 @@ ColmapModel::Camera ColmapCameraFromCamera(const Camera& camera, int id) {
   const double cx = camera.cx + kColmapPixelShift;
   const double cy = camera.cy + kColmapPixelShift;
   const auto& d = camera.distortion;
-  if (!camera.HasDistortion()) {
+  if (camera.model == LensModel::kEquidistant) {
+    // COLMAP's OPENCV_FISHEYE is the same Kannala-Brandt polynomial.
+    c.model = "OPENCV_FISHEYE";
+    c.params = {camera.fx, camera.fy, cx, cy, d[0], d[1], d[2], d[3]};
+  } else if (!camera.HasDistortion()) {
     c.model = "PINHOLE";
     c.params = {camera.fx, camera.fy, cx, cy};
   } else if (d[4] == 0.0) {
@@ -372,6 +377,7 @@ Camera CameraFromColmapCamera(const ColmapModel::Camera& c) {
   for (int k = o + 2; k < std::min(n, o + 6); ++k) {
     camera.distortion[k - o - 2] = p[k];
   }
+  if (c.model == "OPENCV_FISHEYE") camera.model = LensModel::kEquidistant;
   if (c.model == "FULL_OPENCV") {
     if (p[9] != 0 || p[10] != 0 || p[11] != 0) {
       throw InputError(kCamerasFile, where,

@@ -71,13 +71,14 @@ struct ColmapExportReport {
   double mean_reprojection_error_px = 0.0;
 };
 
-// The COLMAP camera for monomap's pinhole + plumb_bob camera: PINHOLE
-// without distortion, OPENCV (fx fy cx cy k1 k2 p1 p2) when k3 = 0, else
-// FULL_OPENCV with k4 = k5 = k6 = 0 (the same polynomial).
+// The COLMAP camera for monomap's camera: PINHOLE without distortion,
+// OPENCV (fx fy cx cy k1 k2 p1 p2) when k3 = 0, else FULL_OPENCV with
+// k4 = k5 = k6 = 0 (the same polynomial); OPENCV_FISHEYE (fx fy cx cy k1 k2
+// k3 k4) for an equidistant lens.
 ColmapModel::Camera ColmapCameraFromCamera(const Camera& camera, int id = 1);
-// Back from SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL, RADIAL, OPENCV and
-// FULL_OPENCV with k4 = k5 = k6 = 0. Throws InputError naming the model
-// for any other camera.
+// Back from SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL, RADIAL, OPENCV,
+// OPENCV_FISHEYE and FULL_OPENCV with k4 = k5 = k6 = 0. Throws InputError
+// naming the model for any other camera.
 Camera CameraFromColmapCamera(const ColmapModel::Camera& camera);
 
 // Builds the model: the map's camera; one image per trajectory pose (id =

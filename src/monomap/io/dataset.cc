@@ -239,16 +239,24 @@ Camera ReadCameraYamlNodes(const fs::path& path) {
   }
   if (const YAML::Node model = root["distortion_model"]) {
     const std::string m = model.as<std::string>("");
-    if (m != "plumb_bob" && m != "none" && !m.empty()) {
-      throw InputError(path.string(), "distortion_model",
-                       "'" + m + "' is not supported (use plumb_bob)");
+    if (m != "none" && !m.empty()) {
+      const auto lens = LensModelFromName(m);
+      if (!lens) {
+        throw InputError(
+            path.string(), "distortion_model",
+            "'" + m + "' is not supported (plumb_bob or equidistant)");
+      }
+      c.model = *lens;
     }
   }
+  const bool fisheye = c.model == LensModel::kEquidistant;
   if (const YAML::Node d = root["distortion_coefficients"]) {
     const YAML::Node data = d["data"];
-    if (!data || !data.IsSequence() || data.size() < 4 || data.size() > 5) {
+    if (!data || !data.IsSequence() || data.size() < 4 ||
+        data.size() > (fisheye ? 4u : 5u)) {
       throw InputError(path.string(), "distortion_coefficients.data",
-                       "expected 4 or 5 numbers (k1 k2 p1 p2 [k3])");
+                       fisheye ? "expected 4 numbers (equidistant k1 k2 k3 k4)"
+                               : "expected 4 or 5 numbers (k1 k2 p1 p2 [k3])");
     }
     const auto dv = ReadNumbers(path, data, "distortion_coefficients.data",
                                 data.size());
@@ -271,10 +279,13 @@ void WriteCameraYaml(const fs::path& path, const Camera& c,
       << "\ncamera_name: " << name << "\ncamera_matrix:\n  rows: 3\n"
       << "  cols: 3\n  data: [" << c.fx << ", 0.0, " << c.cx << ", 0.0, "
       << c.fy << ", " << c.cy << ", 0.0, 0.0, 1.0]\n"
-      << "distortion_model: plumb_bob\ndistortion_coefficients:\n  rows: 1\n"
-      << "  cols: 5\n  data: [" << c.distortion[0] << ", " << c.distortion[1]
-      << ", " << c.distortion[2] << ", " << c.distortion[3] << ", "
-      << c.distortion[4] << "]\n";
+      << "distortion_model: " << LensModelName(c.model)
+      << "\ndistortion_coefficients:\n  rows: 1\n";
+  // equidistant: k1 k2 k3 k4; plumb_bob: k1 k2 p1 p2 k3.
+  const int n = c.model == LensModel::kEquidistant ? 4 : 5;
+  out << "  cols: " << n << "\n  data: [";
+  for (int i = 0; i < n; ++i) out << (i ? ", " : "") << c.distortion[i];
+  out << "]\n";
   WriteFileAtomic(path, out.str());
 }
 

@@ -1,6 +1,6 @@
 // Datasets in monomap's layout (TUM RGB-D style, see
 // docs/dataset-format.md):
-//   camera.yaml            ROS camera_info (plumb_bob)
+//   camera.yaml            ROS camera_info (plumb_bob or equidistant)
 //   rgb.txt                "timestamp relative/path.png"
 //   odometry.txt           TUM trajectory of world_from_cam from odometry
 //     or odometry2d.txt    "timestamp x y yaw" of the robot base

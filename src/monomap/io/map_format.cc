@@ -162,6 +162,17 @@ Camera ReadCamera(const JsonFields& f, const json& root) {
   camera.cy = f.Number(c, "camera", "cy");
   const auto d = f.Vector<5>(c, "camera", "distortion");
   for (int i = 0; i < 5; ++i) camera.distortion[i] = d[i];
+  // "model" is written only for lenses other than plumb_bob, so maps of a
+  // plumb_bob camera read and write as before.
+  if (c.contains("model")) {
+    const std::string name = f.String(c, "camera", "model");
+    const auto model = LensModelFromName(name);
+    if (!model) {
+      f.Fail("camera.model",
+             "'" + name + "' is not supported (plumb_bob or equidistant)");
+    }
+    camera.model = *model;
+  }
   if (camera.width <= 0 || camera.height <= 0) {
     f.Fail(camera.width <= 0 ? "camera.width" : "camera.height",
            "must be positive");
@@ -308,6 +319,9 @@ std::string FormatMapJson(const Map& map) {
                     {"fx", c.fx},         {"fy", c.fy},
                     {"cx", c.cx},         {"cy", c.cy},
                     {"distortion", c.distortion}};
+  if (c.model != LensModel::kPlumbBob) {
+    root["camera"]["model"] = LensModelName(c.model);
+  }
   OrderedJson planes = OrderedJson::array();
   for (const TexturedPlane& p : map.planes) {
     OrderedJson polygon = OrderedJson::array();

@@ -199,6 +199,21 @@ TEST(MapFormatTest, LandmarksAreOptionalAndEmptyMapsWork) {
   EXPECT_TRUE(read_empty.landmarks.empty());
 }
 
+TEST(MapFormatTest, EquidistantLensRoundTrips) {
+  EXPECT_FALSE(LoadJson(WriteTestMap("plumb_bob"))["camera"].contains("model"))
+      << "plumb_bob maps keep their old form";
+  Map map = MakeTestMap();
+  map.camera.model = LensModel::kEquidistant;
+  map.camera.distortion = {0.02, -0.004, 0.001, -0.0002, 0.0};
+  const fs::path dir = WriteTestMap("fisheye", map);
+  EXPECT_EQ(LoadJson(dir)["camera"]["model"], "equidistant");
+  const Map read = ReadMap(dir);
+  EXPECT_EQ(read.camera.model, LensModel::kEquidistant);
+  for (int i = 0; i < 5; ++i) {
+    EXPECT_EQ(read.camera.distortion[i], map.camera.distortion[i]) << i;
+  }
+}
+
 TEST(MapFormatTest, WriteRejectsUnwritableMaps) {
   Map map = MakeTestMap();
   map.planes[1].texture = cv::Mat();
@@ -283,6 +298,8 @@ TEST(MapFormatTest, InvalidFieldsAreNamed) {
        {"field 'planes[1].id'", "duplicate"}},
       {"camera", [](json& j) { j["camera"]["fx"] = -1; },
        {"field 'camera.fx'", "positive"}},
+      {"lens", [](json& j) { j["camera"]["model"] = "fov"; },
+       {"field 'camera.model'", "'fov' is not supported"}},
       {"distortion", [](json& j) { j["camera"]["distortion"] = {0.1}; },
        {"field 'camera.distortion'", "expected 5"}},
       {"no_planes", [](json& j) { j.erase("planes"); },

@@ -27,8 +27,11 @@ inline sensor_msgs::CameraInfo CameraInfoMsg(const Camera& c,
   m.header.frame_id = frame;
   m.width = c.width;
   m.height = c.height;
-  m.distortion_model = "plumb_bob";
-  m.D.assign(c.distortion.begin(), c.distortion.end());
+  m.distortion_model = LensModelName(c.model);
+  // equidistant has k1..k4, plumb_bob k1 k2 p1 p2 k3.
+  m.D.assign(
+      c.distortion.begin(),
+      c.distortion.begin() + (c.model == LensModel::kEquidistant ? 4 : 5));
   m.K = {c.fx, 0, c.cx, 0, c.fy, c.cy, 0, 0, 1};
   m.R = {1, 0, 0, 0, 1, 0, 0, 0, 1};
   m.P = {c.fx, 0, c.cx, 0, 0, c.fy, c.cy, 0, 0, 0, 1, 0};

@@ -301,11 +301,14 @@ Camera ReadEurocSensor(const fs::path& path, Rigid3d* body_from_cam) {
   const std::string model = root["distortion_model"]
                                 ? root["distortion_model"].as<std::string>("")
                                 : "";
-  if (model != "radial-tangential" && model != "radtan") {
+  // Kalibr's names: radial-tangential is plumb_bob without k3, equidistant
+  // the Kannala-Brandt fisheye of ROS and OpenCV.
+  const bool fisheye = model == "equidistant";
+  if (model != "radial-tangential" && model != "radtan" && !fisheye) {
     throw InputError(path.string(), "distortion_model",
                      "'" + model +
-                         "' is not supported (radial-tangential only; "
-                         "monomap's camera model is plumb_bob)");
+                         "' is not supported (radial-tangential or "
+                         "equidistant)");
   }
   const auto size = YamlNumbers(path, root["resolution"], "resolution", 2);
   const auto k = YamlNumbers(path, root["intrinsics"], "intrinsics", 4);
@@ -316,6 +319,7 @@ Camera ReadEurocSensor(const fs::path& path, Rigid3d* body_from_cam) {
   c.height = static_cast<int>(size[1]);
   c.fx = k[0], c.fy = k[1], c.cx = k[2], c.cy = k[3];
   for (int i = 0; i < 4; ++i) c.distortion[i] = d[i];
+  if (fisheye) c.model = LensModel::kEquidistant;
   try {
     c.Check();
   } catch (const OptionsError& e) {

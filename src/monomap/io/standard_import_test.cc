@@ -253,16 +253,25 @@ TEST(EurocImport, CameraGroundTruthIsBodyTimesTbs) {
   EXPECT_LT(worst, 1e-6);
 }
 
-TEST(EurocImport, ErrorsNameTheField) {
+TEST(EurocImport, EquidistantLensIsKept) {
   const fs::path seq = WriteEurocSequence("equidistant");
+  ImportEuroc(seq, kDir / "euroc_fisheye", EurocImportOptions());
+  const Dataset ds = LoadDataset(kDir / "euroc_fisheye");
+  EXPECT_EQ(ds.camera.model, LensModel::kEquidistant);
+  EXPECT_DOUBLE_EQ(ds.camera.distortion[3], 1.7e-05);
+  EXPECT_EQ(ds.camera.distortion[4], 0.0);
+}
+
+TEST(EurocImport, ErrorsNameTheField) {
+  const fs::path seq = WriteEurocSequence("fov");
   std::string e;
   try {
     ImportEuroc(seq, kDir / "euroc_failed", EurocImportOptions());
   } catch (const InputError& error) {
     e = error.what();
   }
-  EXPECT_NE(e.find("sensor.yaml: field 'distortion_model': 'equidistant' is "
-                   "not supported"),
+  EXPECT_NE(e.find("sensor.yaml: field 'distortion_model': 'fov' is not "
+                   "supported"),
             std::string::npos)
       << e;
   EXPECT_FALSE(fs::exists(kDir / "euroc_failed"));

@@ -30,6 +30,8 @@ void SimulationOptions::Check() const {
               "sim.focal_px_at_640", "must be in (50, 5000)");
   CheckOption(std::abs(k1) < 1.0 && std::abs(k2) < 1.0, "sim.k1/k2",
               "must be within +-1");
+  CheckOption(LensModelFromName(lens).has_value(), "sim.lens",
+              "must be plumb_bob or equidistant");
   CheckOption(
       texture_pixels_per_meter >= 20 && texture_pixels_per_meter <= 2000,
       "sim.texture_pixels_per_meter", "must be in [20, 2000]");
@@ -64,6 +66,7 @@ Camera MakeSimulationCamera(const SimulationOptions& options) {
   c.cx = (options.width - 1) * 0.5;
   c.cy = (options.height - 1) * 0.5;
   c.distortion = {options.k1, options.k2, 0.0, 0.0, 0.0};
+  c.model = LensModelFromName(options.lens).value_or(LensModel::kPlumbBob);
   return c;
 }
 

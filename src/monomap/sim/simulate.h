@@ -35,6 +35,9 @@ struct SimulationOptions {
   // Radial distortion (plumb_bob k1, k2): a mild barrel lens.
   double k1 = -0.25;
   double k2 = 0.07;
+  // Lens model: "plumb_bob", or "equidistant" (fisheye; k1, k2 are then
+  // its first two coefficients, k3 = k4 = 0).
+  std::string lens = "plumb_bob";
   // Texture resolution of the world (texels per metre).
   double texture_pixels_per_meter = kDefaultWorldPixelsPerMeter;
   // Robot motion (including start and lateral offsets), camera mount and

@@ -27,7 +27,7 @@ SyntheticScene MakeSyntheticScene(const SyntheticSceneOptions& options) {
                   options.max_track_length >= options.min_track_length,
               "min_track_length/max_track_length", "bad range");
   SyntheticScene scene;
-  scene.camera = SyntheticCamera();
+  scene.camera = options.camera.value_or(SyntheticCamera());
   const Camera& camera = scene.camera;
   std::mt19937_64 rng(options.seed);
   // Trajectory: sideways travel with a gentle vertical wave and a few

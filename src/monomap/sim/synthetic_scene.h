@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "monomap/camera/camera.h"
@@ -30,10 +31,12 @@ struct SyntheticSceneOptions {
   // Gaussian noise (px, per axis) on the observations.
   double pixel_noise_px = 0.0;
   uint64_t seed = 1;
+  // The camera; empty: SyntheticCamera().
+  std::optional<Camera> camera;
 };
 
 struct SyntheticScene {
-  Camera camera;                         // 752x480, f=420, plumb_bob
+  Camera camera;                         // options.camera or SyntheticCamera()
   std::vector<Rigid3d> world_from_cam;   // truth, one per frame
   std::vector<Eigen::Vector3d> points;   // truth, points[i] for tracks[i]
   std::vector<Track> tracks;             // tracks[i].id == i

@@ -468,6 +468,11 @@ ceres::Solver::Options BundleAdjuster::SetUpSolverOptions() {
   }
   if (problem_.HasParameterBlock(distortion_.data())) {
     ordering->AddElementToGroup(distortion_.data(), 1);
+    // equidistant has four coefficients: the fifth stays 0.
+    if (intrinsics_.equidistant) {
+      problem_.SetManifold(distortion_.data(),
+                           new ceres::SubsetManifold(5, {4}));
+    }
   }
   report_.covisibility =
       static_cast<double>(sum_squared_track_length_) / report_.num_residuals;
