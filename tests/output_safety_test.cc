@@ -191,8 +191,10 @@ TEST_F(OutputSafety, ConcurrentWritersAreSerialized) {
   bool waited = false;
   for (int i = 0; i < 6000 && !waited; ++i) {
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    waited = ReadFileToString(second_log).find("waiting for another") !=
-             std::string::npos;
+    // The child creates its log after the fork: it may not be there yet.
+    waited = fs::exists(second_log) &&
+             ReadFileToString(second_log).find("waiting for another") !=
+                 std::string::npos;
   }
   EXPECT_TRUE(waited) << ReadFileToString(second_log);
   kill(first, SIGKILL);
