@@ -20,16 +20,9 @@ void MappingOptions::Check() const {
   planes.Check();
   homographies.Check();
   mosaic.Check();
-  CheckOption(keyframe_interval >= 1, "mapping.keyframe_interval",
-              "must be >= 1");
+  keyframes.Check();
   CheckOption(first_pass_error_factor >= 1.0, "mapping.first_pass_error_factor",
               "must be >= 1");
-  CheckOption(long_sequence_min_keyframes >= 0,
-              "mapping.long_sequence_min_keyframes", "must be >= 0 (0: never)");
-  CheckOption(long_max_observations_per_point >= 2,
-              "mapping.long_max_observations_per_point", "must be >= 2");
-  CheckOption(long_max_point_span_poses >= 2,
-              "mapping.long_max_point_span_poses", "must be >= 2");
   CheckOption(max_observation_radius_px >= 0.0,
               "mapping.max_observation_radius_px", "must be >= 0");
 }
@@ -94,85 +87,6 @@ class ThumbnailCache {
   std::vector<cv::Mat> thumbs_;
 };
 
-// Bundle adjustment over every `interval`-th frame (and the last): the
-// reduced camera system of all frames is a wide band (tracks span ~50
-// frames) and its factorization dominated the build; neighbouring frames
-// add little information. The corrections of the keyframes are then
-// interpolated onto the frames between them (odometry is smooth over a few
-// frames), and the landmarks are re-triangulated by the caller.
-BundleAdjustmentReport BundleAdjustKeyframes(
-    const Camera& camera, const std::vector<Track>& tracks,
-    const BundleAdjustmentOptions& options, int interval,
-    std::vector<Rigid3d>* world_from_cam, std::vector<Landmark>* landmarks) {
-  const int num_frames = static_cast<int>(world_from_cam->size());
-  if (interval <= 1) {
-    return BundleAdjust(camera, tracks, options, world_from_cam, landmarks);
-  }
-  std::vector<int> keyframes;
-  std::vector<int> key_index(num_frames, -1);
-  for (int i = 0; i < num_frames; i += interval) keyframes.push_back(i);
-  if (keyframes.back() != num_frames - 1) keyframes.push_back(num_frames - 1);
-  for (size_t k = 0; k < keyframes.size(); ++k) {
-    key_index[keyframes[k]] = static_cast<int>(k);
-  }
-  std::vector<Rigid3d> key_poses;
-  for (int f : keyframes) key_poses.push_back((*world_from_cam)[f]);
-  std::vector<Track> key_tracks;
-  std::unordered_map<FeatureId, size_t> usable;
-  for (const Track& t : tracks) {
-    Track kt;
-    kt.id = t.id;
-    for (const Observation& o : t.observations) {
-      if (key_index[o.frame] >= 0)
-        kt.observations.push_back({key_index[o.frame], o.px});
-    }
-    if (kt.observations.size() >= 3) {
-      usable[t.id] = key_tracks.size();
-      key_tracks.push_back(std::move(kt));
-    }
-  }
-  std::vector<Landmark> key_landmarks;
-  for (const Landmark& l : *landmarks) {
-    if (usable.count(l.id)) key_landmarks.push_back(l);
-  }
-  BundleAdjustmentReport report =
-      BundleAdjust(camera, key_tracks, options, &key_poses, &key_landmarks);
-  // World-side correction of each keyframe, interpolated in between.
-  std::vector<Rigid3d> corrections;
-  for (size_t k = 0; k < keyframes.size(); ++k) {
-    corrections.push_back(key_poses[k] *
-                          (*world_from_cam)[keyframes[k]].Inverse());
-  }
-  for (size_t k = 0; k + 1 < keyframes.size(); ++k) {
-    const int a = keyframes[k], b = keyframes[k + 1];
-    for (int i = a; i < b; ++i) {
-      const double t = static_cast<double>(i - a) / (b - a);
-      (*world_from_cam)[i] =
-          Interpolate(corrections[k], corrections[k + 1], t) *
-          (*world_from_cam)[i];
-    }
-  }
-  (*world_from_cam)[num_frames - 1] = key_poses.back();
-  *landmarks = std::move(key_landmarks);
-  return report;
-}
-
-// The bundle adjustment options for a sequence of `num_frames`: above
-// long_sequence_min_keyframes keyframes, fewer observations per joint point
-// (see MappingOptions).
-BundleAdjustmentOptions AdjustmentOptionsFor(const MappingOptions& options,
-                                             int num_frames) {
-  BundleAdjustmentOptions ba = options.bundle_adjustment;
-  const int interval = options.keyframe_interval;
-  const int num_keyframes = (num_frames - 1) / interval + 1;
-  if (options.long_sequence_min_keyframes > 0 &&
-      num_keyframes > options.long_sequence_min_keyframes) {
-    ba.max_observations_per_point = options.long_max_observations_per_point;
-    ba.max_point_span_poses = options.long_max_point_span_poses;
-  }
-  return ba;
-}
-
 // Stage 1: tracking (decoding overlaps tracking inside TrackFeatures);
 // keeps colour thumbnails for the landmark colours.
 void TrackStage(const Dataset& dataset, const MappingOptions& options,
@@ -235,13 +149,12 @@ std::vector<Rigid3d> GeometryStage(const Dataset& dataset,
   }
   if (!options.bundle_adjustment.enabled) return world_from_cam;
   timer.Restart();
-  BundleAdjustmentOptions ba =
-      AdjustmentOptionsFor(options, static_cast<int>(world_from_cam.size()));
+  BundleAdjustmentOptions ba = options.bundle_adjustment;
   // The loose first pass carries outliers: the joint solve sees them
   // through the robust loss; dropping uses the loose threshold too.
   ba.max_reprojection_error_px = loose.max_reprojection_error_px;
   report.bundle_adjustment =
-      BundleAdjustKeyframes(*camera, tracks, ba, options.keyframe_interval,
+      BundleAdjustKeyframes(*camera, tracks, ba, options.keyframes,
                             &world_from_cam, &landmarks);
   camera->distortion = report.bundle_adjustment.distortion;
   report.timings.push_back({"bundle_adjustment", timer.ElapsedSeconds()});

@@ -15,6 +15,7 @@
 #include "monomap/texture/mosaic.h"
 #include "monomap/tracking/klt_tracker.h"
 #include "monomap/triangulation/bundle_adjustment.h"
+#include "monomap/triangulation/keyframe_adjustment.h"
 #include "monomap/triangulation/triangulator.h"
 
 namespace monomap {
@@ -42,21 +43,10 @@ struct MappingOptions {
   // views is extrapolated beyond the corners they reached, and a few rim
   // observations then bend every pose (ObservationsWithinRadius).
   double max_observation_radius_px = 0.0;
-  // Bundle adjustment runs on every n-th frame (1: all frames); the other
-  // frames get the interpolated correction of their neighbours.
-  int keyframe_interval = 3;
-  // Long sequences: on a slow run a point is seen by hundreds of keyframes,
-  // and the reduced camera system becomes a wide band whose factorization
-  // grows with the sequence times the band's width squared. Above this many
-  // keyframes (0: never) each joint point enters the adjustment with fewer
-  // observations, so its time and memory grow linearly with the sequence
-  // (figures: docs/benchmarks.md, "Long runs"); shorter sequences are
-  // adjusted with bundle_adjustment as given.
-  int long_sequence_min_keyframes = 400;
-  // ... then BundleAdjustmentOptions::max_observations_per_point,
-  int long_max_observations_per_point = 12;
-  // ... and BundleAdjustmentOptions::max_point_span_poses.
-  int long_max_point_span_poses = 60;
+  // Bundle adjustment runs on keyframes (every n-th frame, spaced by
+  // travel on long sequences); the other frames get the interpolated
+  // correction of their neighbours.
+  KeyframeOptions keyframes;
   // Stop after triangulation + bundle adjustment (a point map only).
   bool points_only = false;
   // Draw progress bars on stderr (only when it is a terminal).
