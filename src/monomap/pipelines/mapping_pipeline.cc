@@ -153,9 +153,8 @@ std::vector<Rigid3d> GeometryStage(const Dataset& dataset,
   // The loose first pass carries outliers: the joint solve sees them
   // through the robust loss; dropping uses the loose threshold too.
   ba.max_reprojection_error_px = loose.max_reprojection_error_px;
-  report.bundle_adjustment =
-      BundleAdjustKeyframes(*camera, tracks, ba, options.keyframes,
-                            &world_from_cam, &landmarks);
+  report.bundle_adjustment = BundleAdjustKeyframes(
+      *camera, tracks, ba, options.keyframes, &world_from_cam, &landmarks);
   camera->distortion = report.bundle_adjustment.distortion;
   report.timings.push_back({"bundle_adjustment", timer.ElapsedSeconds()});
   timer.Restart();

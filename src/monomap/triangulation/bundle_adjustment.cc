@@ -227,27 +227,6 @@ std::vector<char> SelectJointPoints(const std::vector<const Track*>& tracks,
   return joint;
 }
 
-// Indices of the observations of a joint point: those within span / 2
-// poses of its middle observation's (all if span <= 0), of which at most
-// `max` spread evenly from the first to the last (all if max <= 0).
-std::vector<size_t> JointObservations(const std::vector<Observation>& obs,
-                                      int max, int span) {
-  std::vector<size_t> within;
-  const int mid = obs.empty() ? 0 : obs[obs.size() / 2].frame;
-  for (size_t i = 0; i < obs.size(); ++i) {
-    if (span <= 0 || 2 * std::abs(obs[i].frame - mid) <= span) {
-      within.push_back(i);
-    }
-  }
-  const size_t n = within.size();
-  if (max <= 0 || n <= static_cast<size_t>(max)) return within;
-  std::vector<size_t> spread;
-  for (int j = 0; j < max; ++j) {
-    spread.push_back(within[static_cast<size_t>(j) * (n - 1) / (max - 1)]);
-  }
-  return spread;
-}
-
 // The landmarks' tracks, matched by id. Throws InputError if a landmark
 // has no track or a track refers to a frame without pose.
 std::vector<const Track*> MatchLandmarkTracks(
@@ -405,13 +384,9 @@ void BundleAdjuster::AddLandmarkToProblem(size_t i) {
                DepthInCamera(cams_from_world_[obs.frame], points_[i]) > 1e-6;
   }
   if (!in_front) return;
-  const std::vector<size_t> used =
-      JointObservations(observations, options_.max_observations_per_point,
-                        options_.max_point_span_poses);
-  const int64_t k = static_cast<int64_t>(used.size());
+  const int64_t k = static_cast<int64_t>(observations.size());
   sum_squared_track_length_ += k * k;
-  for (const size_t o : used) {
-    const Observation& obs = observations[o];
+  for (const Observation& obs : observations) {
     PoseParams& p = poses_[obs.frame];
     if (options_.refine_distortion) {
       problem_.AddResidualBlock(
@@ -627,11 +602,6 @@ void BundleAdjustmentOptions::Check() const {
   CheckOption(span_translation_sigma_fraction >= 0,
               "span_translation_sigma_fraction", "must be >= 0");
   CheckOption(max_points >= 0, "max_points", "must be >= 0");
-  CheckOption(
-      max_observations_per_point == 0 || max_observations_per_point >= 2,
-      "max_observations_per_point", "must be 0 (all) or >= 2");
-  CheckOption(max_point_span_poses >= 0, "max_point_span_poses",
-              "must be >= 0 (0: whole track)");
   CheckOption(max_num_iterations >= 0, "max_num_iterations", "must be >= 0");
   CheckOption(function_tolerance > 0, "function_tolerance", "must be positive");
   CheckOption(num_threads >= 1, "num_threads", "must be >= 1");

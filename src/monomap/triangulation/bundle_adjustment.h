@@ -71,17 +71,6 @@ struct BundleAdjustmentOptions {
   // over the frames; the other landmarks are then refined one by one with
   // the adjusted poses held fixed.
   int max_points = 3000;
-  // Most observations of one landmark in the joint adjustment (0: all),
-  // spread evenly over its track. Forming the reduced camera system costs a
-  // 6x6 block product per pair of observations of a point: on a slow, long
-  // sequence a point is seen by hundreds of keyframes, and a few tens of
-  // its observations fix it as well. The landmark's final error and
-  // statistics still use every observation.
-  int max_observations_per_point = 0;
-  // ... taken only within this many poses around the middle of its track
-  // (0: the whole track). The reduced camera system then stays a band of
-  // this width, whose factorization grows linearly with the sequence.
-  int max_point_span_poses = 0;
   // Largest Levenberg-Marquardt iterations.
   int max_num_iterations = 50;
   // Ceres stops when the relative cost decrease is below this: the cost

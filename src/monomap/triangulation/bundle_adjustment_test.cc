@@ -80,9 +80,9 @@ TEST(BundleAdjustmentTest, CorrectsOdometryDrift) {
   ASSERT_GT(tri.num_points, 300);
   const Errors before = Compare(scene, poses, landmarks);
 
-  const BundleAdjustmentReport report =
-      BundleAdjust(scene.camera, scene.tracks, BundleAdjustmentOptions(),
-                   &poses, &landmarks);
+  const BundleAdjustmentReport report = BundleAdjust(
+      scene.camera, scene.tracks, BundleAdjustmentOptions(), &poses,
+      &landmarks);
   const Errors after = Compare(scene, poses, landmarks);
   std::printf(
       "tri %d pts, err %.3f px; BA rms %.3f -> %.3f px, median %.3f -> %.3f, "
@@ -312,7 +312,8 @@ TEST(BundleAdjustmentTest, IterativeSchurReachesTheDirectSolution) {
   };
   std::vector<Rigid3d> direct_poses, cg_poses;
   std::vector<Landmark> direct_points, cg_points;
-  const BundleAdjustmentReport direct = run(0.0, &direct_poses, &direct_points);
+  const BundleAdjustmentReport direct =
+      run(0.0, &direct_poses, &direct_points);
   // Below the scene's covisibility: the automatic choice takes CG.
   const BundleAdjustmentReport cg =
       run(0.5 * direct.covisibility, &cg_poses, &cg_points);
@@ -339,70 +340,6 @@ TEST(BundleAdjustmentTest, IterativeSchurReachesTheDirectSolution) {
   // 0.1) the poses differed by 11 um.
   EXPECT_LT(max_pose_diff, 5e-6);
   EXPECT_LT(max_point_diff, 1e-4);
-}
-
-// A slow sequence: every point is seen by ~140 of 300 frames. Capping the
-// joint observations per point (as the mapping pipeline does on long
-// sequences) bounds the reduced camera system's band, and the poses come
-// out as good as with every observation.
-TEST(BundleAdjustmentTest, CappedObservationsPerPointKeepThePoses) {
-  SyntheticSceneOptions scene_options;
-  scene_options.num_frames = 300;
-  scene_options.step_m = 0.002;
-  scene_options.num_tracks = 600;
-  scene_options.min_track_length = 80;
-  scene_options.max_track_length = 200;
-  scene_options.pixel_noise_px = 0.3;
-  scene_options.seed = 21;
-  const SyntheticScene scene = MakeSyntheticScene(scene_options);
-  const std::vector<Rigid3d> odometry =
-      SimulateOdometryDrift(scene.world_from_cam, OdometryDriftOptions());
-  std::vector<Landmark> triangulated;
-  TriangulateTracks(scene.camera, odometry, scene.tracks,
-                    TriangulationOptions(), &triangulated);
-  ASSERT_GT(triangulated.size(), 500u);
-
-  auto run = [&](int max_observations, int span, std::vector<Rigid3d>* poses,
-                 std::vector<Landmark>* landmarks) {
-    *poses = odometry;
-    *landmarks = triangulated;
-    BundleAdjustmentOptions options;
-    options.max_observations_per_point = max_observations;
-    options.max_point_span_poses = span;
-    return BundleAdjust(scene.camera, scene.tracks, options, poses, landmarks);
-  };
-  std::vector<Rigid3d> all_poses, capped_poses;
-  std::vector<Landmark> all_points, capped_points;
-  const BundleAdjustmentReport all = run(0, 0, &all_poses, &all_points);
-  const BundleAdjustmentReport capped =
-      run(12, 60, &capped_poses, &capped_points);
-  const Errors odo = Compare(scene, odometry, triangulated);
-  const Errors e_all = Compare(scene, all_poses, all_points);
-  const Errors e_capped = Compare(scene, capped_poses, capped_points);
-  std::printf(
-      "residuals %d -> %d, covisibility %.1f -> %.1f, %.2f -> %.2f s\n"
-      "position odometry %.3f, all %.3f, capped %.3f mm; rotation %.4f, "
-      "%.4f, %.4f deg; points %.3f, %.3f, %.3f mm\n",
-      all.num_residuals, capped.num_residuals, all.covisibility,
-      capped.covisibility, all.seconds, capped.seconds,
-      1e3 * odo.mean_position_m, 1e3 * e_all.mean_position_m,
-      1e3 * e_capped.mean_position_m, odo.mean_rotation_deg,
-      e_all.mean_rotation_deg, e_capped.mean_rotation_deg,
-      1e3 * odo.median_point_m, 1e3 * e_all.median_point_m,
-      1e3 * e_capped.median_point_m);
-  EXPECT_GT(all.covisibility, 100.0);
-  EXPECT_LE(capped.covisibility, 12.0);
-  EXPECT_EQ(capped.num_points_joint, all.num_points_joint);
-  EXPECT_LE(capped.num_residuals, 12 * capped.num_points_joint);
-  EXPECT_LT(capped.num_residuals, all.num_residuals / 8);
-  EXPECT_EQ(capped.termination, "CONVERGENCE");
-  // Both remove most of the odometry's pose error; the capped problem's
-  // poses are within 1.5 times the full problem's error of the truth.
-  EXPECT_LT(e_all.mean_position_m, odo.mean_position_m / 2.0);
-  EXPECT_LT(e_capped.mean_position_m, odo.mean_position_m / 2.0);
-  EXPECT_LT(e_capped.mean_position_m, 1.5 * e_all.mean_position_m);
-  EXPECT_LT(e_capped.mean_rotation_deg, 1.5 * e_all.mean_rotation_deg);
-  EXPECT_LT(e_capped.median_point_m, 1.5 * e_all.median_point_m);
 }
 
 TEST(BundleAdjustmentTest, DisabledLeavesInputUnchanged) {

@@ -12,8 +12,8 @@ void KeyframeOptions::Check() const {
   CheckOption(interval >= 1, "mapping.keyframe_interval", "must be >= 1");
   CheckOption(long_sequence_min_keyframes >= 0,
               "mapping.long_sequence_min_keyframes", "must be >= 0 (0: never)");
-  CheckOption(long_min_distance_m >= 0.0, "mapping.long_min_keyframe_distance_m",
-              "must be >= 0");
+  CheckOption(long_min_distance_m >= 0.0,
+              "mapping.long_min_keyframe_distance_m", "must be >= 0");
   CheckOption(long_min_angle_deg >= 0.0, "mapping.long_min_keyframe_angle_deg",
               "must be >= 0");
 }
@@ -32,8 +32,7 @@ std::vector<int> SelectKeyframes(const std::vector<Rigid3d>& world_from_cam,
     for (int i = options.interval; i < num_frames; ++i) {
       const int last = keyframes.back();
       if (i - last < options.interval) continue;
-      const Rigid3d motion =
-          world_from_cam[last].Inverse() * world_from_cam[i];
+      const Rigid3d motion = world_from_cam[last].Inverse() * world_from_cam[i];
       if (motion.translation.norm() >= options.long_min_distance_m ||
           RadToDeg(AngleBetween(world_from_cam[last].rotation,
                                 world_from_cam[i].rotation)) >=
