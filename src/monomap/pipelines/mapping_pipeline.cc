@@ -1,6 +1,7 @@
 #include "monomap/pipelines/mapping_pipeline.h"
 
 #include <algorithm>
+#include <fstream>
 #include <mutex>
 #include <opencv2/imgproc.hpp>
 #include <unordered_map>
@@ -334,7 +335,12 @@ void WriteMappingResult(const std::filesystem::path& dir,
                         const MappingResult& result) {
   AtomicDirectory out(dir, "map");
   WriteMap(out.path(), result.map);
-  WriteFeatureTable(out.path() / "features.csv", result.tracks);
+  // Streamed: the directory appears whole or not at all anyway.
+  const std::filesystem::path features = out.path() / "features.csv";
+  std::ofstream stream(features, std::ios::binary);
+  WriteFeatureTable(stream, result.tracks);
+  stream.flush();
+  if (!stream) throw OutputError(features.string() + ": write failed");
   out.Commit();
 }
 
