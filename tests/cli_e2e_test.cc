@@ -621,7 +621,7 @@ TEST(CliHelp, BuildShowsTheMappingOptionsDefaults) {
             Shown(o.planes.ransac_iterations))
       << r.output;
   EXPECT_EQ(HelpDefault(r.output, "--keyframe-interval"),
-            Shown(o.keyframe_interval));
+            Shown(o.keyframes.interval));
   EXPECT_EQ(HelpDefault(r.output, "--features"),
             Shown(o.tracking.target_features));
   EXPECT_EQ(HelpDefault(r.output, "--odometry-translation-sigma"),

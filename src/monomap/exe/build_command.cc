@@ -93,7 +93,7 @@ void AddMappingOptions(CLI::App* cmd, BuildArgs* a) {
   cmd->add_option("--ransac-iterations", o.planes.ransac_iterations,
                   "RANSAC hypotheses per plane")
       ->capture_default_str();
-  cmd->add_option("--keyframe-interval", o.keyframe_interval,
+  cmd->add_option("--keyframe-interval", o.keyframes.interval,
                   "Bundle-adjust every n-th frame (1: all frames)")
       ->capture_default_str();
   AddTrackingOptions(cmd, &o.tracking);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <ostream>
 #include <unordered_map>
 
 #include "monomap/util/error.h"
@@ -45,33 +46,49 @@ bool ParseInteger(const std::string& token, T* value) {
   return result.ec == std::errc() && result.ptr == end && !token.empty();
 }
 
+std::string FeatureTableHeader() {
+  return std::string(kFeatureTableComment) + "\n" + kFeatureTableColumns + "\n";
+}
+
+// Appends the rows of one track.
+void AppendTrackRows(const Track& track, std::string* out) {
+  const std::string id = std::to_string(track.id);
+  for (const Observation& obs : track.observations) {
+    *out += id;
+    *out += ',';
+    *out += std::to_string(obs.frame);
+    *out += ',';
+    AppendDouble(obs.px.x(), out);
+    *out += ',';
+    AppendDouble(obs.px.y(), out);
+    *out += '\n';
+  }
+}
+
 }  // namespace
 
 std::string FormatFeatureTable(const std::vector<Track>& tracks) {
-  std::string out;
-  out += kFeatureTableComment;
-  out += "\n";
-  out += kFeatureTableColumns;
-  out += "\n";
-  for (const Track& track : tracks) {
-    const std::string id = std::to_string(track.id);
-    for (const Observation& obs : track.observations) {
-      out += id;
-      out += ',';
-      out += std::to_string(obs.frame);
-      out += ',';
-      AppendDouble(obs.px.x(), &out);
-      out += ',';
-      AppendDouble(obs.px.y(), &out);
-      out += '\n';
-    }
-  }
+  std::string out = FeatureTableHeader();
+  for (const Track& track : tracks) AppendTrackRows(track, &out);
   return out;
 }
 
 void WriteFeatureTable(const std::filesystem::path& path,
                        const std::vector<Track>& tracks) {
   WriteFileAtomic(path, FormatFeatureTable(tracks));
+}
+
+void WriteFeatureTable(std::ostream& out, const std::vector<Track>& tracks) {
+  constexpr size_t kChunkBytes = 1 << 20;
+  std::string chunk = FeatureTableHeader();
+  for (const Track& track : tracks) {
+    AppendTrackRows(track, &chunk);
+    if (chunk.size() >= kChunkBytes) {
+      out.write(chunk.data(), static_cast<std::streamsize>(chunk.size()));
+      chunk.clear();
+    }
+  }
+  out.write(chunk.data(), static_cast<std::streamsize>(chunk.size()));
 }
 
 std::vector<Track> ReadFeatureTable(const std::filesystem::path& path) {
@@ -107,9 +124,9 @@ std::vector<Track> ReadFeatureTable(const std::filesystem::path& path) {
     }
     int frame = 0;
     if (!ParseInteger(fields[1], &frame) || frame < 0) {
-      throw InputError(file, line.number,
-                       "frame '" + fields[1] +
-                           "' is not a non-negative integer");
+      throw InputError(
+          file, line.number,
+          "frame '" + fields[1] + "' is not a non-negative integer");
     }
     Observation obs;
     obs.frame = frame;
@@ -138,8 +155,8 @@ std::vector<Track> ReadFeatureTable(const std::filesystem::path& path) {
     std::vector<Observation> sorted;
     sorted.reserve(order.size());
     for (size_t k = 0; k < order.size(); ++k) {
-      if (k > 0 && observations[order[k]].frame ==
-                       observations[order[k - 1]].frame) {
+      if (k > 0 &&
+          observations[order[k]].frame == observations[order[k - 1]].frame) {
         const int first = line_of_obs[t][std::min(order[k], order[k - 1])];
         const int second = line_of_obs[t][std::max(order[k], order[k - 1])];
         throw InputError(file, second,

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <filesystem>
+#include <iosfwd>
 #include <string>
 #include <vector>
 
@@ -24,6 +25,10 @@ std::string FormatFeatureTable(const std::vector<Track>& tracks);
 // Writes the table atomically. Throws OutputError on failure.
 void WriteFeatureTable(const std::filesystem::path& path,
                        const std::vector<Track>& tracks);
+// The table written to `out` in pieces of about a megabyte, for a long
+// sequence, whose table is over 100 MB (a whole string grown by doubling
+// would need twice that).
+void WriteFeatureTable(std::ostream& out, const std::vector<Track>& tracks);
 
 // Reads a table back into tracks: tracks in order of first appearance, the
 // observations of each sorted by frame. Blank lines and lines starting with

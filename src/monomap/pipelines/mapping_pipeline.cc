@@ -1,6 +1,7 @@
 #include "monomap/pipelines/mapping_pipeline.h"
 
 #include <algorithm>
+#include <fstream>
 #include <mutex>
 #include <opencv2/imgproc.hpp>
 #include <unordered_map>
@@ -20,8 +21,7 @@ void MappingOptions::Check() const {
   planes.Check();
   homographies.Check();
   mosaic.Check();
-  CheckOption(keyframe_interval >= 1, "mapping.keyframe_interval",
-              "must be >= 1");
+  keyframes.Check();
   CheckOption(first_pass_error_factor >= 1.0, "mapping.first_pass_error_factor",
               "must be >= 1");
   CheckOption(max_observation_radius_px >= 0.0,
@@ -88,131 +88,49 @@ class ThumbnailCache {
   std::vector<cv::Mat> thumbs_;
 };
 
-// Bundle adjustment over every `interval`-th frame (and the last): the
-// reduced camera system of all frames is a wide band (tracks span ~50
-// frames) and its factorization dominated the build; neighbouring frames
-// add little information. The corrections of the keyframes are then
-// interpolated onto the frames between them (odometry is smooth over a few
-// frames), and the landmarks are re-triangulated by the caller.
-BundleAdjustmentReport BundleAdjustKeyframes(
-    const Camera& camera, const std::vector<Track>& tracks,
-    const BundleAdjustmentOptions& options, int interval,
-    std::vector<Rigid3d>* world_from_cam, std::vector<Landmark>* landmarks) {
-  const int num_frames = static_cast<int>(world_from_cam->size());
-  if (interval <= 1) {
-    return BundleAdjust(camera, tracks, options, world_from_cam, landmarks);
-  }
-  std::vector<int> keyframes;
-  std::vector<int> key_index(num_frames, -1);
-  for (int i = 0; i < num_frames; i += interval) keyframes.push_back(i);
-  if (keyframes.back() != num_frames - 1) keyframes.push_back(num_frames - 1);
-  for (size_t k = 0; k < keyframes.size(); ++k) {
-    key_index[keyframes[k]] = static_cast<int>(k);
-  }
-  std::vector<Rigid3d> key_poses;
-  for (int f : keyframes) key_poses.push_back((*world_from_cam)[f]);
-  std::vector<Track> key_tracks;
-  std::unordered_map<FeatureId, size_t> usable;
-  for (const Track& t : tracks) {
-    Track kt;
-    kt.id = t.id;
-    for (const Observation& o : t.observations) {
-      if (key_index[o.frame] >= 0)
-        kt.observations.push_back({key_index[o.frame], o.px});
-    }
-    if (kt.observations.size() >= 3) {
-      usable[t.id] = key_tracks.size();
-      key_tracks.push_back(std::move(kt));
-    }
-  }
-  std::vector<Landmark> key_landmarks;
-  for (const Landmark& l : *landmarks) {
-    if (usable.count(l.id)) key_landmarks.push_back(l);
-  }
-  BundleAdjustmentReport report =
-      BundleAdjust(camera, key_tracks, options, &key_poses, &key_landmarks);
-  // World-side correction of each keyframe, interpolated in between.
-  std::vector<Rigid3d> corrections;
-  for (size_t k = 0; k < keyframes.size(); ++k) {
-    corrections.push_back(key_poses[k] *
-                          (*world_from_cam)[keyframes[k]].Inverse());
-  }
-  for (size_t k = 0; k + 1 < keyframes.size(); ++k) {
-    const int a = keyframes[k], b = keyframes[k + 1];
-    for (int i = a; i < b; ++i) {
-      const double t = static_cast<double>(i - a) / (b - a);
-      (*world_from_cam)[i] =
-          Interpolate(corrections[k], corrections[k + 1], t) *
-          (*world_from_cam)[i];
-    }
-  }
-  (*world_from_cam)[num_frames - 1] = key_poses.back();
-  *landmarks = std::move(key_landmarks);
-  return report;
-}
-
-}  // namespace
-
-MappingResult BuildMap(const Dataset& dataset, const MappingOptions& options) {
-  options.Check();
-  Timer total;
-  MappingResult result;
-  MappingReport& report = result.report;
+// Stage 1: tracking (decoding overlaps tracking inside TrackFeatures);
+// keeps colour thumbnails for the landmark colours.
+void TrackStage(const Dataset& dataset, const MappingOptions& options,
+                ThumbnailCache* thumbs, MappingResult* result) {
   const int num_frames = static_cast<int>(dataset.frames.size());
-  report.num_frames = num_frames;
-  if (num_frames < 2) {
-    throw StageError("need at least 2 frames to build a map, got " +
-                     std::to_string(num_frames));
-  }
-  // The dataset's calibration; bundle adjustment may refine its distortion,
-  // and every stage after it (and the map) uses the refined lens.
-  Camera camera = dataset.camera;
-  camera.Check();
-
-  // Stage 1: tracking (decoding overlaps tracking inside TrackFeatures).
   Timer timer;
-  ThumbnailCache thumbs(num_frames);
-  {
-    ProgressBar progress("tracking", num_frames, options.show_progress);
-    auto load = [&](int frame) {
-      cv::Mat grey;
-      if (ThumbnailCache::Wanted(frame)) {
-        const cv::Mat color = dataset.LoadImage(frame, /*color=*/true);
-        thumbs.Store(frame, color);
-        cv::cvtColor(color, grey, cv::COLOR_BGR2GRAY);
-      } else {
-        grey = dataset.LoadImage(frame, /*color=*/false);
-      }
-      progress.Advance();
-      return grey;
-    };
-    report.tracking =
-        TrackFeatures(load, num_frames, options.tracking, &result.tracks);
-  }
-  report.timings.push_back({"tracking", timer.ElapsedSeconds()});
-  if (result.tracks.empty()) {
+  ProgressBar progress("tracking", num_frames, options.show_progress);
+  auto load = [&](int frame) {
+    cv::Mat grey;
+    if (ThumbnailCache::Wanted(frame)) {
+      const cv::Mat color = dataset.LoadImage(frame, /*color=*/true);
+      thumbs->Store(frame, color);
+      cv::cvtColor(color, grey, cv::COLOR_BGR2GRAY);
+    } else {
+      grey = dataset.LoadImage(frame, /*color=*/false);
+    }
+    progress.Advance();
+    return grey;
+  };
+  result->report.tracking =
+      TrackFeatures(load, num_frames, options.tracking, &result->tracks);
+  result->report.timings.push_back({"tracking", timer.ElapsedSeconds()});
+  if (result->tracks.empty()) {
     throw StageError("tracking found no features in " + dataset.root.string());
   }
+}
 
-  // The geometry sees only the observations where the lens is trusted.
-  std::vector<Track> inner_tracks;
-  const std::vector<Track>* tracks = &result.tracks;
-  if (options.max_observation_radius_px > 0.0) {
-    inner_tracks = ObservationsWithinRadius(result.tracks, camera,
-                                            options.max_observation_radius_px,
-                                            &report.observations_beyond_radius);
-    tracks = &inner_tracks;
-  }
-
-  // Stage 2: triangulation with odometry poses, then bundle adjustment.
-  timer.Restart();
+// Stage 2: triangulation against the odometry poses, bundle adjustment and
+// triangulation again against the adjusted poses. Returns world_from_cam
+// per frame; *camera gets the distortion bundle adjustment settled on.
+std::vector<Rigid3d> GeometryStage(const Dataset& dataset,
+                                   const MappingOptions& options,
+                                   const std::vector<Track>& tracks,
+                                   Camera* camera, MappingResult* result) {
+  MappingReport& report = result->report;
+  Timer timer;
   std::vector<Rigid3d> world_from_cam;
-  world_from_cam.reserve(num_frames);
+  world_from_cam.reserve(dataset.frames.size());
   for (const auto& f : dataset.frames) {
     world_from_cam.push_back(f.odometry_world_from_cam);
   }
-  result.odometry_world_from_cam = world_from_cam;
-  std::vector<Landmark>& landmarks = result.map.landmarks;
+  result->odometry_world_from_cam = world_from_cam;
+  std::vector<Landmark>& landmarks = result->map.landmarks;
   // With drifting odometry poses a strict reprojection test would reject
   // good tracks, so the first pass is loose: bundle adjustment (robust
   // loss) then corrects the poses, and every track is triangulated again
@@ -223,72 +141,110 @@ MappingResult BuildMap(const Dataset& dataset, const MappingOptions& options) {
     loose.max_observation_error_px *= options.first_pass_error_factor;
   }
   report.triangulation =
-      TriangulateTracks(camera, world_from_cam, *tracks, loose, &landmarks);
+      TriangulateTracks(*camera, world_from_cam, tracks, loose, &landmarks);
   report.timings.push_back({"triangulation", timer.ElapsedSeconds()});
   if (landmarks.empty()) {
     throw StageError(
         "no track could be triangulated (too little motion or "
         "too few features?)");
   }
+  if (!options.bundle_adjustment.enabled) return world_from_cam;
   timer.Restart();
-  if (options.bundle_adjustment.enabled) {
-    BundleAdjustmentOptions ba = options.bundle_adjustment;
-    // The loose first pass carries outliers: the joint solve sees them
-    // through the robust loss; dropping uses the loose threshold too.
-    ba.max_reprojection_error_px = loose.max_reprojection_error_px;
-    report.bundle_adjustment =
-        BundleAdjustKeyframes(camera, *tracks, ba, options.keyframe_interval,
-                              &world_from_cam, &landmarks);
-    camera.distortion = report.bundle_adjustment.distortion;
-    report.timings.push_back({"bundle_adjustment", timer.ElapsedSeconds()});
-    timer.Restart();
-    report.retriangulation = TriangulateTracks(
-        camera, world_from_cam, *tracks, options.triangulation, &landmarks);
-    report.timings.push_back({"retriangulation", timer.ElapsedSeconds()});
-  }
+  BundleAdjustmentOptions ba = options.bundle_adjustment;
+  // The loose first pass carries outliers: the joint solve sees them
+  // through the robust loss; dropping uses the loose threshold too.
+  ba.max_reprojection_error_px = loose.max_reprojection_error_px;
+  report.bundle_adjustment = BundleAdjustKeyframes(
+      *camera, tracks, ba, options.keyframes, &world_from_cam, &landmarks);
+  camera->distortion = report.bundle_adjustment.distortion;
+  report.timings.push_back({"bundle_adjustment", timer.ElapsedSeconds()});
+  timer.Restart();
+  report.retriangulation = TriangulateTracks(*camera, world_from_cam, tracks,
+                                             options.triangulation, &landmarks);
+  report.timings.push_back({"retriangulation", timer.ElapsedSeconds()});
+  return world_from_cam;
+}
 
-  // Landmark colours from a frame near the middle of each track.
-  {
-    std::unordered_map<FeatureId, const Track*> track_by_id;
-    for (const auto& t : result.tracks) track_by_id[t.id] = &t;
-    for (auto& l : landmarks) {
-      const auto it = track_by_id.find(l.id);
-      if (it == track_by_id.end()) continue;
-      l.color = thumbs.TrackColor(*it->second);
-    }
+// Landmark colours from a frame near the middle of each track.
+void ColorLandmarks(const ThumbnailCache& thumbs,
+                    const std::vector<Track>& tracks,
+                    std::vector<Landmark>* landmarks) {
+  std::unordered_map<FeatureId, const Track*> track_by_id;
+  for (const auto& t : tracks) track_by_id[t.id] = &t;
+  for (auto& l : *landmarks) {
+    const auto it = track_by_id.find(l.id);
+    if (it == track_by_id.end()) continue;
+    l.color = thumbs.TrackColor(*it->second);
   }
+}
 
+// Stages 3 to 5: planes, image-to-plane homographies and texture mosaics.
+void SurfaceStages(const Dataset& dataset, const MappingOptions& options,
+                   const Camera& camera,
+                   const std::vector<Rigid3d>& world_from_cam,
+                   const std::vector<Track>& tracks, MappingResult* result) {
+  MappingReport& report = result->report;
+  std::vector<Landmark>& landmarks = result->map.landmarks;
+  Timer timer;
+  std::vector<Eigen::Vector3d> centers;
+  for (const auto& p : world_from_cam) centers.push_back(p.translation);
+  report.planes =
+      FitPlanes(options.planes, &landmarks, &result->segments, &centers);
+  report.timings.push_back({"planes", timer.ElapsedSeconds()});
+  auto load_image = [&](int frame) { return dataset.LoadImage(frame, true); };
+  timer.Restart();
+  std::vector<ImagePlaneHomography> homographies;
+  report.homographies = ComputeImagePlaneHomographies(
+      camera, world_from_cam, result->segments, landmarks, tracks,
+      options.homographies, &homographies);
+  report.timings.push_back({"homographies", timer.ElapsedSeconds()});
+  timer.Restart();
+  report.mosaic = BuildTexturedPlanes(
+      camera, world_from_cam, result->segments, landmarks, tracks, homographies,
+      load_image, options.mosaic, &result->map.planes);
+  report.timings.push_back({"mosaic", timer.ElapsedSeconds()});
+}
+
+}  // namespace
+
+MappingResult BuildMap(const Dataset& dataset, const MappingOptions& options) {
+  options.Check();
+  Timer total;
+  MappingResult result;
+  const int num_frames = static_cast<int>(dataset.frames.size());
+  result.report.num_frames = num_frames;
+  if (num_frames < 2) {
+    throw StageError("need at least 2 frames to build a map, got " +
+                     std::to_string(num_frames));
+  }
+  // The dataset's calibration; bundle adjustment may refine its distortion,
+  // and every stage after it (and the map) uses the refined lens.
+  Camera camera = dataset.camera;
+  camera.Check();
+  ThumbnailCache thumbs(num_frames);
+  TrackStage(dataset, options, &thumbs, &result);
+  // The geometry sees only the observations where the lens is trusted.
+  std::vector<Track> inner_tracks;
+  const std::vector<Track>* tracks = &result.tracks;
+  if (options.max_observation_radius_px > 0.0) {
+    inner_tracks = ObservationsWithinRadius(
+        result.tracks, camera, options.max_observation_radius_px,
+        &result.report.observations_beyond_radius);
+    tracks = &inner_tracks;
+  }
+  const std::vector<Rigid3d> world_from_cam =
+      GeometryStage(dataset, options, *tracks, &camera, &result);
+  ColorLandmarks(thumbs, result.tracks, &result.map.landmarks);
   result.map.camera = camera;
   result.map.trajectory.reserve(num_frames);
   for (int i = 0; i < num_frames; ++i) {
     result.map.trajectory.push_back(
         {dataset.frames[i].timestamp, world_from_cam[i]});
   }
-
   if (!options.points_only) {
-    // Stage 3: planes.
-    timer.Restart();
-    std::vector<Eigen::Vector3d> centers;
-    for (const auto& p : world_from_cam) centers.push_back(p.translation);
-    report.planes =
-        FitPlanes(options.planes, &landmarks, &result.segments, &centers);
-    report.timings.push_back({"planes", timer.ElapsedSeconds()});
-
-    // Stages 4 and 5: homographies and mosaics.
-    auto load_image = [&](int frame) { return dataset.LoadImage(frame, true); };
-    timer.Restart();
-    std::vector<ImagePlaneHomography> homographies;
-    report.homographies = ComputeImagePlaneHomographies(
-        camera, world_from_cam, result.segments, landmarks, *tracks,
-        options.homographies, &homographies);
-    report.timings.push_back({"homographies", timer.ElapsedSeconds()});
-    timer.Restart();
-    report.mosaic = BuildTexturedPlanes(
-        camera, world_from_cam, result.segments, landmarks, *tracks,
-        homographies, load_image, options.mosaic, &result.map.planes);
-    report.timings.push_back({"mosaic", timer.ElapsedSeconds()});
+    SurfaceStages(dataset, options, camera, world_from_cam, *tracks, &result);
   }
-  report.total_seconds = total.ElapsedSeconds();
+  result.report.total_seconds = total.ElapsedSeconds();
   return result;
 }
 
@@ -324,6 +280,7 @@ nlohmann::json MappingReport::ToJson() const {
   j["bundle_adjustment"] = {
       {"termination", bundle_adjustment.termination},
       {"poses", bundle_adjustment.num_poses},
+      {"residuals", bundle_adjustment.num_residuals},
       {"span_priors", bundle_adjustment.num_span_priors},
       {"points_joint", bundle_adjustment.num_points_joint},
       {"initial_rms_reprojection_error_px",
@@ -378,7 +335,12 @@ void WriteMappingResult(const std::filesystem::path& dir,
                         const MappingResult& result) {
   AtomicDirectory out(dir, "map");
   WriteMap(out.path(), result.map);
-  WriteFeatureTable(out.path() / "features.csv", result.tracks);
+  // Streamed: the directory appears whole or not at all anyway.
+  const std::filesystem::path features = out.path() / "features.csv";
+  std::ofstream stream(features, std::ios::binary);
+  WriteFeatureTable(stream, result.tracks);
+  stream.flush();
+  if (!stream) throw OutputError(features.string() + ": write failed");
   out.Commit();
 }
 

@@ -15,6 +15,7 @@
 #include "monomap/texture/mosaic.h"
 #include "monomap/tracking/klt_tracker.h"
 #include "monomap/triangulation/bundle_adjustment.h"
+#include "monomap/triangulation/keyframe_adjustment.h"
 #include "monomap/triangulation/triangulator.h"
 
 namespace monomap {
@@ -42,9 +43,10 @@ struct MappingOptions {
   // views is extrapolated beyond the corners they reached, and a few rim
   // observations then bend every pose (ObservationsWithinRadius).
   double max_observation_radius_px = 0.0;
-  // Bundle adjustment runs on every n-th frame (1: all frames); the other
-  // frames get the interpolated correction of their neighbours.
-  int keyframe_interval = 3;
+  // Bundle adjustment runs on keyframes (every n-th frame, spaced by
+  // travel on long sequences); the other frames get the interpolated
+  // correction of their neighbours.
+  KeyframeOptions keyframes;
   // Stop after triangulation + bundle adjustment (a point map only).
   bool points_only = false;
   // Draw progress bars on stderr (only when it is a terminal).
