@@ -41,6 +41,33 @@ struct NavGridTruthGeometry {
   }
 };
 
+// The xy segments where the horizontal line at height z crosses a
+// vertical plane's polygon (even-odd over the polygon's edges).
+inline std::vector<std::pair<Vector2d, Vector2d>> FootprintAtHeight(
+    const TexturedPlane& p, double z) {
+  std::vector<double> s_cross;  // positions along the line, in metres
+  const Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d along = up.cross(p.plane.normal).normalized();
+  const size_t n = p.polygon.size();
+  for (size_t i = 0; i < n; ++i) {
+    const Eigen::Vector3d a = p.frame.ToWorld(p.polygon[i]);
+    const Eigen::Vector3d b = p.frame.ToWorld(p.polygon[(i + 1) % n]);
+    if ((a.z() - z) * (b.z() - z) > 0 || a.z() == b.z()) continue;
+    // Half-open in z ([low, high)), so a vertex on the line counts once.
+    if (z == std::max(a.z(), b.z())) continue;
+    const double t = (z - a.z()) / (b.z() - a.z());
+    s_cross.push_back(along.dot(a + t * (b - a)));
+  }
+  std::sort(s_cross.begin(), s_cross.end());
+  std::vector<std::pair<Vector2d, Vector2d>> segments;
+  const Eigen::Vector3d origin = p.plane.Project(Eigen::Vector3d(0, 0, z));
+  for (size_t i = 0; i + 1 < s_cross.size(); i += 2) {
+    segments.push_back({(origin + s_cross[i] * along).head<2>(),
+                        (origin + s_cross[i + 1] * along).head<2>()});
+  }
+  return segments;
+}
+
 inline NavGridTruthGeometry NavGridTruth(
     const std::vector<TexturedPlane>& planes, const NavGridOptions& o) {
   NavGridTruthGeometry truth;
@@ -60,15 +87,15 @@ inline NavGridTruthGeometry NavGridTruth(
     } else if (z_hi < o.min_z_m || z_lo > o.max_z_m) {
       continue;
     } else if (std::abs(p.plane.normal.z()) < 0.1) {
-      // A vertical rectangle: its xy footprint is the segment between the
-      // two farthest corners.
-      std::pair<Vector2d, Vector2d> seg{xy[0], xy[0]};
-      for (const Vector2d& a : xy) {
-        for (const Vector2d& b : xy) {
-          if ((a - b).norm() > (seg.first - seg.second).norm()) seg = {a, b};
+      // A vertical plane: its xy footprint within the band, cut at the
+      // band's bottom, middle and top (a wall's door opening, cut out of
+      // its polygon, is no wall there).
+      for (const double z : {o.min_z_m, 0.5 * (o.min_z_m + o.max_z_m),
+                             o.max_z_m}) {
+        for (const auto& seg : FootprintAtHeight(p, z)) {
+          truth.segments.push_back(seg);
         }
       }
-      truth.segments.push_back(seg);
     } else {
       truth.areas.push_back(xy);
     }
