@@ -49,6 +49,12 @@ LocalizationNode::LocalizationNode(ros::NodeHandle nh, ros::NodeHandle pnh,
   global_service_ = nh.advertiseService(
       "global_localization", &LocalizationNode::OnGlobalLocalization, this);
   PublishStatus("waiting", {});
+  if (!options_.camera_frame.empty() || options_.base_from_cam) {
+    start_timer_ = nh.createWallTimer(ros::WallDuration(0.1), [this](const auto&) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (EnsureSession(options_.camera_frame)) start_timer_.stop();
+    });
+  }
 }
 
 LocalizationNode::~LocalizationNode() {
@@ -117,6 +123,7 @@ bool LocalizationNode::EnsureSession(const std::string& camera_frame) {
   session_->Start([this](const SessionResult& r) { OnResult(r); });
   ROS_INFO("localizing with camera mount %s -> %s", options_.base_frame.c_str(),
            camera_frame.c_str());
+  PublishStatus("ready", {});
   return true;
 }
 

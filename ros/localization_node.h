@@ -68,6 +68,7 @@ class LocalizationNode {
   ros::Subscriber image_sub_, info_sub_, odom_sub_, initial_pose_sub_;
   ros::Publisher pose_pub_, particles_pub_, status_pub_;
   ros::ServiceServer global_service_;
+  ros::WallTimer start_timer_;  // starts the session before any image
   tf2_ros::Buffer tf_buffer_;
   tf2_ros::TransformListener tf_listener_;
   tf2_ros::TransformBroadcaster tf_broadcaster_;

@@ -121,6 +121,7 @@ NodeOptions ReadNodeOptions(const ros::NodeHandle& pnh) {
   pnh.param("odom_frame_id", n.odom_frame, n.odom_frame);
   pnh.param("base_frame_id", n.base_frame, n.base_frame);
   n.base_from_cam = ReadPose(pnh, "base_from_camera");
+  pnh.param("camera_frame_id", n.camera_frame, n.camera_frame);
   pnh.param("transform_tolerance", n.transform_tolerance,
             n.transform_tolerance);
   pnh.param("camera_info_tolerance_px", n.camera_info_tolerance_px,

@@ -28,6 +28,10 @@ struct NodeOptions {
   std::string base_frame = "base_link";
   // The camera mount; empty: looked up on tf (base -> the image's frame).
   std::optional<Rigid3d> base_from_cam;
+  // The camera's tf frame. Set: the mount is looked up (and the session
+  // started, which takes a while) before the first image, so that no
+  // image is lost to the start; empty: the first image's frame.
+  std::string camera_frame;
   // map -> odom is stamped this far after the image, as AMCL's
   // transform_tolerance (s).
   double transform_tolerance = 0.1;
