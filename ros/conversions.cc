@@ -5,41 +5,13 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "monomap/io/ros_image.h"
 #include "monomap/util/error.h"
 
 namespace monomap::ros_adapter {
 
 cv::Mat ImageFromMsg(const sensor_msgs::Image& msg) {
-  int type = 0;
-  if (msg.encoding == "mono8") {
-    type = CV_8UC1;
-  } else if (msg.encoding == "bgr8" || msg.encoding == "rgb8") {
-    type = CV_8UC3;
-  } else {
-    throw InputError("sensor_msgs/Image", "encoding",
-                     "'" + msg.encoding +
-                         "' is not supported (mono8, bgr8 or rgb8)");
-  }
-  const size_t row_bytes = size_t(msg.width) * CV_ELEM_SIZE(type);
-  if (msg.width == 0 || msg.height == 0 || msg.step < row_bytes ||
-      msg.data.size() < size_t(msg.step) * msg.height) {
-    throw InputError("sensor_msgs/Image", "data",
-                     std::to_string(msg.data.size()) + " bytes do not hold " +
-                         std::to_string(msg.width) + "x" +
-                         std::to_string(msg.height) + " " + msg.encoding +
-                         " pixels with step " + std::to_string(msg.step));
-  }
-  // The message's buffer viewed in place, then copied (the session keeps
-  // the frame after the message is gone).
-  const cv::Mat view(int(msg.height), int(msg.width), type,
-                     const_cast<uint8_t*>(msg.data.data()), msg.step);
-  cv::Mat image;
-  if (msg.encoding == "rgb8") {
-    cv::cvtColor(view, image, cv::COLOR_RGB2BGR);
-  } else {
-    image = view.clone();
-  }
-  return image;
+  return PixelsOfImageMsg(msg, "sensor_msgs/Image");
 }
 
 cv::Mat ImageFromMsg(const sensor_msgs::CompressedImage& msg) {

@@ -19,6 +19,7 @@
 
 #include "monomap/io/camera_mount.h"
 #include "monomap/io/dataset_writer.h"
+#include "monomap/io/ros_image.h"
 #include "monomap/io/trajectory_io.h"
 #include "monomap/util/error.h"
 #include "monomap/util/file.h"
@@ -262,33 +263,9 @@ struct DecodedImage {
 
 DecodedImage DecodeRaw(const sensor_msgs::Image& msg,
                        const std::string& where) {
-  int type = 0;
-  if (msg.encoding == "mono8") {
-    type = CV_8UC1;
-  } else if (msg.encoding == "bgr8" || msg.encoding == "rgb8") {
-    type = CV_8UC3;
-  } else {
-    throw InputError(where, "encoding",
-                     "'" + msg.encoding +
-                         "' is not supported (mono8, bgr8, rgb8 or "
-                         "sensor_msgs/CompressedImage)");
-  }
-  const size_t row_bytes = size_t(msg.width) * CV_ELEM_SIZE(type);
-  if (msg.step < row_bytes || msg.data.size() < size_t(msg.step) * msg.height) {
-    throw InputError(where, "data",
-                     "holds " + std::to_string(msg.data.size()) +
-                         " bytes, too few for " + std::to_string(msg.width) +
-                         "x" + std::to_string(msg.height) + " " + msg.encoding);
-  }
-  const cv::Mat view(int(msg.height), int(msg.width), type,
-                     const_cast<uint8_t*>(msg.data.data()), msg.step);
   DecodedImage d;
   d.encoding = msg.encoding;
-  if (msg.encoding == "rgb8") {
-    cv::cvtColor(view, d.pixels, cv::COLOR_RGB2BGR);
-  } else {
-    d.pixels = view.clone();
-  }
+  d.pixels = PixelsOfImageMsg(msg, where);
   d.extension = ".png";
   if (!cv::imencode(".png", d.pixels, d.encoded)) {
     throw OutputError(where + ": PNG encoding failed");
