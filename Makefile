@@ -13,6 +13,7 @@ DEB_PACKAGES = cmake ninja-build g++ pkg-config libopencv-dev libeigen3-dev \
   colmap help2man \
   librosbag-dev libsensor-msgs-dev libnav-msgs-dev libtf2-msgs-dev \
   libgeometry-msgs-dev libsqlite3-dev libfastcdr-dev \
+  libroscpp-dev libtf2-ros-dev libstd-srvs-dev ros-core \
   libjs-three libjs-chart.js
 
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
