@@ -49,6 +49,12 @@ void PlaneFittingOptions::Check() const {
               "planes.covariance_sigmas", "must be finite and >= 0");
   CheckOption(polygon_cell_factor > 0, "planes.polygon_cell_factor",
               "must be > 0");
+  CheckOption(merge_max_angle_deg >= 0 && merge_max_angle_deg < 90,
+              "planes.merge_max_angle_deg", "must be in [0, 90)");
+  CheckOption(merge_max_offset_m >= 0 && std::isfinite(merge_max_offset_m),
+              "planes.merge_max_offset_m", "must be finite and >= 0");
+  CheckOption(merge_max_gap_m >= 0 && std::isfinite(merge_max_gap_m),
+              "planes.merge_max_gap_m", "must be finite and >= 0");
 }
 
 namespace {
@@ -491,6 +497,136 @@ Attempt TryHypothesis(int attempt, FitState* s) {
   return accepted ? Attempt::kAccepted : Attempt::kRejected;
 }
 
+// Positions of a segment's inliers (landmark index by id).
+std::vector<Eigen::Vector3d> InlierPoints(
+    const FitState& s, const std::unordered_map<FeatureId, int>& index,
+    const PlaneSegment& seg) {
+  std::vector<Eigen::Vector3d> out;
+  out.reserve(seg.inlier_ids.size());
+  for (FeatureId id : seg.inlier_ids) {
+    out.push_back(s.lms[index.at(id)].x_in_world);
+  }
+  return out;
+}
+
+double MedianDistance(const Plane& plane,
+                      const std::vector<Eigen::Vector3d>& x) {
+  std::vector<double> d(x.size());
+  for (size_t i = 0; i < x.size(); ++i) {
+    d[i] = std::abs(plane.SignedDistance(x[i]));
+  }
+  std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
+  return d[d.size() / 2];
+}
+
+// Smallest distance between the polygons of a and b, in a's plane.
+double PolygonGap(const PlaneSegment& a, const PlaneSegment& b) {
+  double gap = std::numeric_limits<double>::infinity();
+  for (const Eigen::Vector2d& v : b.polygon) {
+    gap = std::min(
+        gap, DistanceToPolygon(a.polygon, a.frame.ToPlane(b.frame.ToWorld(v))));
+  }
+  for (const Eigen::Vector2d& v : a.polygon) {
+    gap = std::min(
+        gap, DistanceToPolygon(b.polygon, b.frame.ToPlane(a.frame.ToWorld(v))));
+  }
+  return gap;
+}
+
+// Whether a and b are one physical plane: normals and offsets agree within
+// the noise (centroids and each one's inliers against the other's fit) and
+// their supports touch. Fills the merge record's angle and offset.
+bool SameSurface(const PlaneFittingOptions& o, const PlaneSegment& a,
+                 const std::vector<Eigen::Vector3d>& pa, const PlaneSegment& b,
+                 const std::vector<Eigen::Vector3d>& pb,
+                 PlaneFittingReport::Merge* m) {
+  m->angle_deg = PlaneAngle(a.plane, b.plane) * 180.0 / M_PI;
+  if (m->angle_deg > o.merge_max_angle_deg) return false;
+  m->offset_m =
+      std::max({std::abs(b.plane.SignedDistance(a.frame.origin)),
+                std::abs(a.plane.SignedDistance(b.frame.origin)),
+                MedianDistance(b.plane, pa), MedianDistance(a.plane, pb)});
+  if (m->offset_m > o.merge_max_offset_m) return false;
+  return PolygonGap(a, b) <= o.merge_max_gap_m;
+}
+
+// Refits seg (plane, frame, in-plane coordinates, polygon) to its points.
+void RefitSegment(const FitState& s, const std::vector<Eigen::Vector3d>& pts,
+                  PlaneSegment* seg) {
+  seg->plane = FitPlaneLeastSquares(pts);
+  OrientPlane(s.camera_centers, &seg->plane);
+  SetSegmentFrame(pts, seg);
+  seg->inlier_st.resize(pts.size());
+  for (size_t k = 0; k < pts.size(); ++k) {
+    seg->inlier_st[k] = seg->frame.ToPlane(pts[k]);
+  }
+  const PlaneFittingOptions& o = s.options;
+  double radius = o.connectivity_radius_m;
+  if (radius <= 0) {
+    radius = std::clamp(
+        o.connectivity_factor * MedianNearestNeighbourSpacing(seg->inlier_st),
+        o.min_connectivity_radius_m, o.max_connectivity_radius_m);
+  }
+  seg->polygon =
+      o.concave_polygon
+          ? OccupancyOutline(seg->inlier_st, o.polygon_cell_factor * radius)
+          : ConvexHull(seg->inlier_st);
+}
+
+// Merges the first pair of segments that are one surface; false if none.
+bool MergeOnePair(FitState* s, std::vector<std::vector<Eigen::Vector3d>>* pts,
+                  std::vector<int>* fitted_id) {
+  std::vector<PlaneSegment>& segs = *s->segments;
+  for (size_t i = 0; i < segs.size(); ++i) {
+    for (size_t j = i + 1; j < segs.size(); ++j) {
+      PlaneFittingReport::Merge m;
+      if (!SameSurface(s->options, segs[i], (*pts)[i], segs[j], (*pts)[j],
+                       &m)) {
+        continue;
+      }
+      m.kept_id = (*fitted_id)[i];
+      m.merged_id = (*fitted_id)[j];
+      s->report->merges.push_back(m);
+      segs[i].inlier_ids.insert(segs[i].inlier_ids.end(),
+                                segs[j].inlier_ids.begin(),
+                                segs[j].inlier_ids.end());
+      (*pts)[i].insert((*pts)[i].end(), (*pts)[j].begin(), (*pts)[j].end());
+      RefitSegment(*s, (*pts)[i], &segs[i]);
+      segs.erase(segs.begin() + j);
+      pts->erase(pts->begin() + j);
+      fitted_id->erase(fitted_id->begin() + j);
+      return true;
+    }
+  }
+  return false;
+}
+
+// One map plane per physical plane: RANSAC and the connectivity split can
+// cut one wall into pieces; merge them and renumber the segments.
+void MergeCoplanar(FitState* s) {
+  std::vector<PlaneSegment>& segs = *s->segments;
+  std::unordered_map<FeatureId, int> index;
+  for (int i = 0; i < static_cast<int>(s->lms.size()); ++i) {
+    index[s->lms[i].id] = i;
+  }
+  std::vector<std::vector<Eigen::Vector3d>> pts;
+  std::vector<int> fitted_id;
+  for (const PlaneSegment& seg : segs) {
+    pts.push_back(InlierPoints(*s, index, seg));
+    fitted_id.push_back(seg.id);
+  }
+  while (MergeOnePair(s, &pts, &fitted_id)) {
+  }
+  s->report->inliers_per_plane.clear();
+  for (size_t k = 0; k < segs.size(); ++k) {
+    segs[k].id = static_cast<int>(k);
+    for (FeatureId id : segs[k].inlier_ids)
+      s->lms[index.at(id)].plane_id = segs[k].id;
+    s->report->inliers_per_plane.push_back(
+        static_cast<int>(segs[k].inlier_ids.size()));
+  }
+}
+
 }  // namespace
 
 PlaneFittingReport FitPlanes(
@@ -515,6 +651,7 @@ PlaneFittingReport FitPlanes(
     failures = result == Attempt::kAccepted ? 0 : failures + 1;
     std::erase_if(s.remaining, [&](int i) { return s.taken[i] != 0; });
   }
+  if (options.merge_coplanar) MergeCoplanar(&s);
   report.num_planes = static_cast<int>(segments->size());
   report.num_outliers = 0;
   for (const auto& lm : *landmarks) {
