@@ -302,6 +302,14 @@ nlohmann::json MappingReport::ToJson() const {
       {"outliers", planes.num_outliers},
       {"absorbed_outliers", planes.absorbed},
       {"inliers_per_plane", planes.inliers_per_plane}};
+  // Segments merged into one plane (ids as fitted), empty unless merging is on.
+  planes_json["merges"] = nlohmann::json::array();
+  for (const auto& m : planes.merges) {
+    planes_json["merges"].push_back({{"kept_id", m.kept_id},
+                                     {"merged_id", m.merged_id},
+                                     {"angle_deg", m.angle_deg},
+                                     {"offset_m", m.offset_m}});
+  }
   j["planes"] = planes_json;
   j["homographies"] = {
       {"count", homographies.num_homographies},

@@ -49,6 +49,12 @@ void PlaneFittingOptions::Check() const {
               "planes.covariance_sigmas", "must be finite and >= 0");
   CheckOption(polygon_cell_factor > 0, "planes.polygon_cell_factor",
               "must be > 0");
+  CheckOption(merge_max_angle_deg >= 0 && merge_max_angle_deg < 90,
+              "planes.merge_max_angle_deg", "must be in [0, 90)");
+  CheckOption(merge_max_offset_m >= 0 && std::isfinite(merge_max_offset_m),
+              "planes.merge_max_offset_m", "must be finite and >= 0");
+  CheckOption(merge_max_gap_m >= 0 && std::isfinite(merge_max_gap_m),
+              "planes.merge_max_gap_m", "must be finite and >= 0");
 }
 
 namespace {
@@ -236,6 +242,391 @@ uint64_t MixSeed(uint64_t seed, uint64_t k) {
   return z ^ (z >> 31);
 }
 
+// The state FitPlanes' stages share: the landmarks still in the search, their
+// thresholds, and the segments found so far.
+struct FitState {
+  FitState(const PlaneFittingOptions& o, std::vector<Landmark>& l,
+           std::vector<PlaneSegment>* segs,
+           const std::vector<Eigen::Vector3d>* centers, PlaneFittingReport* r)
+      : options(o),
+        lms(l),
+        segments(segs),
+        camera_centers(centers),
+        report(r) {}
+  const PlaneFittingOptions& options;
+  std::vector<Landmark>& lms;
+  std::vector<PlaneSegment>* segments;
+  const std::vector<Eigen::Vector3d>* camera_centers;
+  PlaneFittingReport* report;
+  std::vector<double> thresholds;      // per landmark
+  std::vector<int> remaining;          // landmarks still searched
+  std::vector<char> taken;             // on a segment or set aside
+  std::vector<Eigen::Vector3d> pts{};  // x_in_world of `remaining`
+  std::vector<double> inv_thr{};       // 1 / threshold of `remaining`
+  size_t min_count = 0;
+};
+
+// Per-landmark threshold; invalid points never enter the search.
+void InitSearch(FitState* s) {
+  const PlaneFittingOptions& o = s->options;
+  const int n = static_cast<int>(s->lms.size());
+  s->thresholds.assign(n, o.min_threshold_m);
+  s->taken.assign(n, 0);
+  s->remaining.reserve(n);
+  for (int i = 0; i < n; ++i) {
+    s->lms[i].plane_id = -1;
+    if (!s->lms[i].x_in_world.allFinite()) continue;
+    const double depth = s->lms[i].mean_depth_m;
+    if (std::isfinite(depth) && depth > 0) {
+      s->thresholds[i] = std::clamp(o.relative_threshold * depth,
+                                    o.min_threshold_m, o.max_threshold_m);
+    }
+    s->remaining.push_back(i);
+  }
+  s->min_count = static_cast<size_t>(
+      std::max<double>(o.min_inliers, std::ceil(o.min_inlier_fraction * n)));
+}
+
+// Least squares on the inliers, re-selecting them each time.
+void RefineHypothesis(const FitState& s, const PlaneEstimator& estimator,
+                      Plane* plane, std::vector<size_t>* inliers) {
+  std::vector<Eigen::Vector3d> inlier_pts;
+  for (int it = 0; it < s.options.refine_iterations; ++it) {
+    inlier_pts.clear();
+    for (size_t k : *inliers) inlier_pts.push_back(s.pts[k]);
+    const Plane refined = FitPlaneLeastSquares(inlier_pts);
+    std::vector<size_t> reselected;
+    for (size_t k = 0; k < s.pts.size(); ++k) {
+      if (estimator.Residual(refined, k) <= 1.0) reselected.push_back(k);
+    }
+    if (reselected.size() < 3) break;
+    *plane = refined;
+    if (reselected == *inliers) break;
+    *inliers = std::move(reselected);
+  }
+}
+
+// A "ghost": nearly the same plane as an accepted segment, made of the
+// points just outside that segment's threshold (its noisier points).
+// They are outliers of the real plane, not a second surface.
+bool IsGhost(const FitState& s, const Plane& plane,
+             const std::vector<size_t>& inliers) {
+  bool ghost = false;
+  for (const PlaneSegment& seg : *s.segments) {
+    if (PlaneAngle(seg.plane, plane) >
+        s.options.ghost_max_angle_deg * M_PI / 180.0) {
+      continue;
+    }
+    double dist = 0.0, thr = 0.0;
+    for (size_t k : inliers) {
+      dist += std::abs(seg.plane.SignedDistance(s.pts[k]));
+      thr += 1.0 / s.inv_thr[k];
+    }
+    if (dist < s.options.ghost_distance_factor * thr) ghost = true;
+  }
+  return ghost;
+}
+
+// Splits the inliers into connected regions of the plane; *radius is the
+// connectivity radius used.
+std::vector<std::vector<int>> SplitRegions(const FitState& s,
+                                           const Plane& plane,
+                                           const std::vector<size_t>& inliers,
+                                           double* radius) {
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (size_t k : inliers) centroid += s.pts[k];
+  centroid /= static_cast<double>(inliers.size());
+  const PlaneFrame split_frame =
+      MakePlaneFrame(plane, centroid, plane.normal.unitOrthogonal());
+  std::vector<Eigen::Vector2d> st(inliers.size());
+  for (size_t k = 0; k < inliers.size(); ++k) {
+    st[k] = split_frame.ToPlane(s.pts[inliers[k]]);
+  }
+  *radius = s.options.connectivity_radius_m;
+  if (*radius <= 0) {
+    *radius = std::clamp(
+        s.options.connectivity_factor * MedianNearestNeighbourSpacing(st),
+        s.options.min_connectivity_radius_m,
+        s.options.max_connectivity_radius_m);
+  }
+  return ConnectedComponents(st, *radius);
+}
+
+// Orientation: towards the cameras, else towards the world origin.
+void OrientPlane(const std::vector<Eigen::Vector3d>* camera_centers,
+                 Plane* plane) {
+  bool flip = plane->offset < 0;
+  if (camera_centers != nullptr && !camera_centers->empty()) {
+    int votes = 0;
+    double sum = 0.0;
+    for (const auto& c : *camera_centers) {
+      const double d = plane->SignedDistance(c);
+      votes += d > 0 ? 1 : (d < 0 ? -1 : 0);
+      sum += d;
+    }
+    flip = votes < 0 || (votes == 0 && sum < 0);
+  }
+  if (flip) {
+    plane->normal = -plane->normal;
+    plane->offset = -plane->offset;
+  }
+}
+
+// Frame: centroid origin, u along the principal in-plane direction. Sets
+// seg->frame and seg->rms_distance_m from its points.
+void SetSegmentFrame(const std::vector<Eigen::Vector3d>& cpts,
+                     PlaneSegment* seg) {
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  for (const auto& p : cpts) c += p;
+  c /= static_cast<double>(cpts.size());
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  double sq = 0.0;
+  for (const auto& p : cpts) {
+    const double dist = seg->plane.SignedDistance(p);
+    sq += dist * dist;
+    const Eigen::Vector3d d = (p - c) - dist * seg->plane.normal;
+    scatter += d * d.transpose();
+  }
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(scatter);
+  Eigen::Vector3d u = eig.eigenvectors().col(2);
+  Eigen::Index big;
+  u.cwiseAbs().maxCoeff(&big);
+  if (u(big) < 0) u = -u;  // canonical sign: deterministic frames
+  seg->frame = MakePlaneFrame(seg->plane, c, u);
+  seg->rms_distance_m = std::sqrt(sq / cpts.size());
+}
+
+// Marks remaining outliers consistent with `seg` (within their uncertainty
+// and near its polygon) as taken, so no later plane claims them.
+void AbsorbConsistent(const PlaneSegment& seg, double radius, FitState* s) {
+  const double k = s->options.covariance_sigmas * s->options.tracking_noise_px;
+  for (int lm : s->remaining) {
+    if (s->taken[lm]) continue;
+    const Eigen::Vector3d& x = s->lms[lm].x_in_world;
+    const double band = std::max(
+        s->thresholds[lm], CovarianceBand(s->lms[lm], seg.plane.normal, k));
+    if (std::abs(seg.plane.SignedDistance(x)) > band) continue;
+    const Eigen::Vector2d q = seg.frame.ToPlane(x);
+    if (DistanceToPolygon(seg.polygon, q) <= radius) {
+      s->taken[lm] = 1;
+      ++s->report->absorbed;
+    }
+  }
+}
+
+// Turns one connected region of a hypothesis' inliers into a segment.
+void AddSegment(const std::vector<size_t>& inliers,
+                const std::vector<int>& comp, double radius, FitState* s) {
+  PlaneSegment seg;
+  seg.id = static_cast<int>(s->segments->size());
+  std::vector<Eigen::Vector3d> cpts;
+  cpts.reserve(comp.size());
+  for (int c : comp) cpts.push_back(s->pts[inliers[c]]);
+  seg.plane = FitPlaneLeastSquares(cpts);
+  OrientPlane(s->camera_centers, &seg.plane);
+  SetSegmentFrame(cpts, &seg);
+  seg.inlier_ids.reserve(comp.size());
+  seg.inlier_st.reserve(comp.size());
+  for (int k : comp) {
+    const int lm = s->remaining[inliers[k]];
+    s->lms[lm].plane_id = seg.id;
+    s->taken[lm] = 1;
+    seg.inlier_ids.push_back(s->lms[lm].id);
+    seg.inlier_st.push_back(seg.frame.ToPlane(s->lms[lm].x_in_world));
+  }
+  seg.polygon = s->options.concave_polygon
+                    ? OccupancyOutline(seg.inlier_st,
+                                       s->options.polygon_cell_factor * radius)
+                    : ConvexHull(seg.inlier_st);
+  s->report->inliers_per_plane.push_back(static_cast<int>(comp.size()));
+  if (s->options.absorb_consistent_points) AbsorbConsistent(seg, radius, s);
+  s->segments->push_back(std::move(seg));
+}
+
+// Sets the points of a rejected hypothesis aside so the next one differs.
+void SetAside(const std::vector<size_t>& inliers, FitState* s) {
+  ++s->report->rejected_hypotheses;
+  for (size_t k : inliers) s->taken[s->remaining[k]] = 1;
+}
+
+enum class Attempt { kAccepted, kRejected, kExhausted };
+
+// One RANSAC hypothesis over the remaining points: refined, checked for a
+// ghost, split into regions, each big enough region kept as a segment.
+Attempt TryHypothesis(int attempt, FitState* s) {
+  const PlaneFittingOptions& o = s->options;
+  s->pts.resize(s->remaining.size());
+  s->inv_thr.resize(s->remaining.size());
+  for (size_t k = 0; k < s->remaining.size(); ++k) {
+    s->pts[k] = s->lms[s->remaining[k]].x_in_world;
+    s->inv_thr[k] = 1.0 / s->thresholds[s->remaining[k]];
+  }
+  const PlaneEstimator estimator{&s->pts, &s->inv_thr};
+  RansacOptions ransac;
+  ransac.max_iterations = o.ransac_iterations;
+  ransac.min_iterations = std::min(ransac.min_iterations, o.ransac_iterations);
+  ransac.inlier_threshold = 1.0;
+  ransac.confidence = 1.0;
+  ransac.seed = MixSeed(o.seed, attempt);
+  const auto best = Ransac(estimator, ransac);
+  s->report->iterations += best.iterations;
+  // The best plane is too small: the rest is noise.
+  if (!best.success || best.inliers.size() < s->min_count) {
+    return Attempt::kExhausted;
+  }
+  Plane plane = best.model;
+  std::vector<size_t> inliers = best.inliers;
+  RefineHypothesis(*s, estimator, &plane, &inliers);
+  if (IsGhost(*s, plane, inliers)) {
+    SetAside(inliers, s);
+    return Attempt::kRejected;
+  }
+  double radius = 0.0;
+  bool accepted = false;
+  for (const auto& comp : SplitRegions(*s, plane, inliers, &radius)) {
+    if (comp.size() < s->min_count ||
+        static_cast<int>(s->segments->size()) >= o.max_planes) {
+      ++s->report->discarded_regions;
+      continue;
+    }
+    accepted = true;
+    AddSegment(inliers, comp, radius, s);
+  }
+  // No coherent region: a plane through clutter.
+  if (!accepted) SetAside(inliers, s);
+  return accepted ? Attempt::kAccepted : Attempt::kRejected;
+}
+
+// Positions of a segment's inliers (landmark index by id).
+std::vector<Eigen::Vector3d> InlierPoints(
+    const FitState& s, const std::unordered_map<FeatureId, int>& index,
+    const PlaneSegment& seg) {
+  std::vector<Eigen::Vector3d> out;
+  out.reserve(seg.inlier_ids.size());
+  for (FeatureId id : seg.inlier_ids) {
+    out.push_back(s.lms[index.at(id)].x_in_world);
+  }
+  return out;
+}
+
+double MedianDistance(const Plane& plane,
+                      const std::vector<Eigen::Vector3d>& x) {
+  std::vector<double> d(x.size());
+  for (size_t i = 0; i < x.size(); ++i) {
+    d[i] = std::abs(plane.SignedDistance(x[i]));
+  }
+  std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
+  return d[d.size() / 2];
+}
+
+// Smallest distance between the polygons of a and b, in a's plane.
+double PolygonGap(const PlaneSegment& a, const PlaneSegment& b) {
+  double gap = std::numeric_limits<double>::infinity();
+  for (const Eigen::Vector2d& v : b.polygon) {
+    gap = std::min(
+        gap, DistanceToPolygon(a.polygon, a.frame.ToPlane(b.frame.ToWorld(v))));
+  }
+  for (const Eigen::Vector2d& v : a.polygon) {
+    gap = std::min(
+        gap, DistanceToPolygon(b.polygon, b.frame.ToPlane(a.frame.ToWorld(v))));
+  }
+  return gap;
+}
+
+// Whether a and b are one physical plane: normals and offsets agree within
+// the noise (centroids and each one's inliers against the other's fit) and
+// their supports touch. Fills the merge record's angle and offset.
+bool SameSurface(const PlaneFittingOptions& o, const PlaneSegment& a,
+                 const std::vector<Eigen::Vector3d>& pa, const PlaneSegment& b,
+                 const std::vector<Eigen::Vector3d>& pb,
+                 PlaneFittingReport::Merge* m) {
+  m->angle_deg = PlaneAngle(a.plane, b.plane) * 180.0 / M_PI;
+  if (m->angle_deg > o.merge_max_angle_deg) return false;
+  m->offset_m =
+      std::max({std::abs(b.plane.SignedDistance(a.frame.origin)),
+                std::abs(a.plane.SignedDistance(b.frame.origin)),
+                MedianDistance(b.plane, pa), MedianDistance(a.plane, pb)});
+  if (m->offset_m > o.merge_max_offset_m) return false;
+  return PolygonGap(a, b) <= o.merge_max_gap_m;
+}
+
+// Refits seg (plane, frame, in-plane coordinates, polygon) to its points.
+void RefitSegment(const FitState& s, const std::vector<Eigen::Vector3d>& pts,
+                  PlaneSegment* seg) {
+  seg->plane = FitPlaneLeastSquares(pts);
+  OrientPlane(s.camera_centers, &seg->plane);
+  SetSegmentFrame(pts, seg);
+  seg->inlier_st.resize(pts.size());
+  for (size_t k = 0; k < pts.size(); ++k) {
+    seg->inlier_st[k] = seg->frame.ToPlane(pts[k]);
+  }
+  const PlaneFittingOptions& o = s.options;
+  double radius = o.connectivity_radius_m;
+  if (radius <= 0) {
+    radius = std::clamp(
+        o.connectivity_factor * MedianNearestNeighbourSpacing(seg->inlier_st),
+        o.min_connectivity_radius_m, o.max_connectivity_radius_m);
+  }
+  seg->polygon =
+      o.concave_polygon
+          ? OccupancyOutline(seg->inlier_st, o.polygon_cell_factor * radius)
+          : ConvexHull(seg->inlier_st);
+}
+
+// Merges the first pair of segments that are one surface; false if none.
+bool MergeOnePair(FitState* s, std::vector<std::vector<Eigen::Vector3d>>* pts,
+                  std::vector<int>* fitted_id) {
+  std::vector<PlaneSegment>& segs = *s->segments;
+  for (size_t i = 0; i < segs.size(); ++i) {
+    for (size_t j = i + 1; j < segs.size(); ++j) {
+      PlaneFittingReport::Merge m;
+      if (!SameSurface(s->options, segs[i], (*pts)[i], segs[j], (*pts)[j],
+                       &m)) {
+        continue;
+      }
+      m.kept_id = (*fitted_id)[i];
+      m.merged_id = (*fitted_id)[j];
+      s->report->merges.push_back(m);
+      segs[i].inlier_ids.insert(segs[i].inlier_ids.end(),
+                                segs[j].inlier_ids.begin(),
+                                segs[j].inlier_ids.end());
+      (*pts)[i].insert((*pts)[i].end(), (*pts)[j].begin(), (*pts)[j].end());
+      RefitSegment(*s, (*pts)[i], &segs[i]);
+      segs.erase(segs.begin() + j);
+      pts->erase(pts->begin() + j);
+      fitted_id->erase(fitted_id->begin() + j);
+      return true;
+    }
+  }
+  return false;
+}
+
+// One map plane per physical plane: RANSAC and the connectivity split can
+// cut one wall into pieces; merge them and renumber the segments.
+void MergeCoplanar(FitState* s) {
+  std::vector<PlaneSegment>& segs = *s->segments;
+  std::unordered_map<FeatureId, int> index;
+  for (int i = 0; i < static_cast<int>(s->lms.size()); ++i) {
+    index[s->lms[i].id] = i;
+  }
+  std::vector<std::vector<Eigen::Vector3d>> pts;
+  std::vector<int> fitted_id;
+  for (const PlaneSegment& seg : segs) {
+    pts.push_back(InlierPoints(*s, index, seg));
+    fitted_id.push_back(seg.id);
+  }
+  while (MergeOnePair(s, &pts, &fitted_id)) {
+  }
+  s->report->inliers_per_plane.clear();
+  for (size_t k = 0; k < segs.size(); ++k) {
+    segs[k].id = static_cast<int>(k);
+    for (FeatureId id : segs[k].inlier_ids)
+      s->lms[index.at(id)].plane_id = segs[k].id;
+    s->report->inliers_per_plane.push_back(
+        static_cast<int>(segs[k].inlier_ids.size()));
+  }
+}
+
 }  // namespace
 
 PlaneFittingReport FitPlanes(
@@ -246,211 +637,26 @@ PlaneFittingReport FitPlanes(
   Timer timer;
   PlaneFittingReport report;
   segments->clear();
-  std::vector<Landmark>& lms = *landmarks;
-  const int n = static_cast<int>(lms.size());
-  report.num_points = n;
-
-  // Per-landmark threshold; invalid points never enter the search.
-  std::vector<double> thresholds(n, options.min_threshold_m);
-  std::vector<int> remaining;
-  remaining.reserve(n);
-  for (int i = 0; i < n; ++i) {
-    lms[i].plane_id = -1;
-    if (!lms[i].x_in_world.allFinite()) continue;
-    const double depth = lms[i].mean_depth_m;
-    if (std::isfinite(depth) && depth > 0) {
-      thresholds[i] =
-          std::clamp(options.relative_threshold * depth,
-                     options.min_threshold_m, options.max_threshold_m);
-    }
-    remaining.push_back(i);
-  }
-  const size_t min_count = static_cast<size_t>(std::max<double>(
-      options.min_inliers, std::ceil(options.min_inlier_fraction * n)));
-
-  std::vector<Eigen::Vector3d> pts;
-  std::vector<double> inv_thr;
-  std::vector<char> taken(n, 0);  // on a segment or set aside
+  FitState s(options, *landmarks, segments, camera_centers, &report);
+  report.num_points = static_cast<int>(landmarks->size());
+  InitSearch(&s);
   int failures = 0;
   for (int attempt = 0;
        static_cast<int>(segments->size()) < options.max_planes &&
-       remaining.size() >= min_count &&
+       s.remaining.size() >= s.min_count &&
        failures < options.max_consecutive_failures;
        ++attempt) {
-    pts.resize(remaining.size());
-    inv_thr.resize(remaining.size());
-    for (size_t k = 0; k < remaining.size(); ++k) {
-      pts[k] = lms[remaining[k]].x_in_world;
-      inv_thr[k] = 1.0 / thresholds[remaining[k]];
-    }
-    const PlaneEstimator estimator{&pts, &inv_thr};
-    RansacOptions ransac;
-    ransac.max_iterations = options.ransac_iterations;
-    ransac.min_iterations =
-        std::min(ransac.min_iterations, options.ransac_iterations);
-    ransac.inlier_threshold = 1.0;
-    ransac.confidence = 1.0;
-    ransac.seed = MixSeed(options.seed, attempt);
-    const auto best = Ransac(estimator, ransac);
-    report.iterations += best.iterations;
-    // The best plane is too small: the rest is noise.
-    if (!best.success || best.inliers.size() < min_count) break;
-
-    // Least squares on the inliers, re-selecting them each time.
-    Plane plane = best.model;
-    std::vector<size_t> inliers = best.inliers;
-    std::vector<Eigen::Vector3d> inlier_pts;
-    for (int it = 0; it < options.refine_iterations; ++it) {
-      inlier_pts.clear();
-      for (size_t k : inliers) inlier_pts.push_back(pts[k]);
-      const Plane refined = FitPlaneLeastSquares(inlier_pts);
-      std::vector<size_t> reselected;
-      for (size_t k = 0; k < pts.size(); ++k) {
-        if (estimator.Residual(refined, k) <= 1.0) reselected.push_back(k);
-      }
-      if (reselected.size() < 3) break;
-      plane = refined;
-      if (reselected == inliers) break;
-      inliers = std::move(reselected);
-    }
-
-    // A "ghost": nearly the same plane as an accepted segment, made of the
-    // points just outside that segment's threshold (its noisier points).
-    // They are outliers of the real plane, not a second surface.
-    bool ghost = false;
-    for (const PlaneSegment& seg : *segments) {
-      if (PlaneAngle(seg.plane, plane) >
-          options.ghost_max_angle_deg * M_PI / 180.0) {
-        continue;
-      }
-      double dist = 0.0, thr = 0.0;
-      for (size_t k : inliers) {
-        dist += std::abs(seg.plane.SignedDistance(pts[k]));
-        thr += 1.0 / inv_thr[k];
-      }
-      if (dist < options.ghost_distance_factor * thr) ghost = true;
-    }
-    if (ghost) {
-      ++report.rejected_hypotheses;
-      ++failures;
-      for (size_t k : inliers) taken[remaining[k]] = 1;
-      std::erase_if(remaining, [&](int i) { return taken[i] != 0; });
-      continue;
-    }
-
-    // Split the inliers into connected regions of the plane.
-    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-    for (size_t k : inliers) centroid += pts[k];
-    centroid /= static_cast<double>(inliers.size());
-    const PlaneFrame split_frame =
-        MakePlaneFrame(plane, centroid, plane.normal.unitOrthogonal());
-    std::vector<Eigen::Vector2d> st(inliers.size());
-    for (size_t k = 0; k < inliers.size(); ++k) {
-      st[k] = split_frame.ToPlane(pts[inliers[k]]);
-    }
-    double radius = options.connectivity_radius_m;
-    if (radius <= 0) {
-      radius = std::clamp(
-          options.connectivity_factor * MedianNearestNeighbourSpacing(st),
-          options.min_connectivity_radius_m, options.max_connectivity_radius_m);
-    }
-    const auto components = ConnectedComponents(st, radius);
-
-    bool accepted = false;
-    for (const auto& comp : components) {
-      if (comp.size() < min_count ||
-          static_cast<int>(segments->size()) >= options.max_planes) {
-        ++report.discarded_regions;
-        continue;
-      }
-      accepted = true;
-      PlaneSegment seg;
-      seg.id = static_cast<int>(segments->size());
-      std::vector<Eigen::Vector3d> cpts;
-      cpts.reserve(comp.size());
-      for (int c : comp) cpts.push_back(pts[inliers[c]]);
-      seg.plane = FitPlaneLeastSquares(cpts);
-      // Orientation: towards the cameras, else towards the world origin.
-      bool flip = seg.plane.offset < 0;
-      if (camera_centers != nullptr && !camera_centers->empty()) {
-        int votes = 0;
-        double sum = 0.0;
-        for (const auto& c : *camera_centers) {
-          const double d = seg.plane.SignedDistance(c);
-          votes += d > 0 ? 1 : (d < 0 ? -1 : 0);
-          sum += d;
-        }
-        flip = votes < 0 || (votes == 0 && sum < 0);
-      }
-      if (flip) {
-        seg.plane.normal = -seg.plane.normal;
-        seg.plane.offset = -seg.plane.offset;
-      }
-      // Frame: centroid origin, u along the principal in-plane direction.
-      Eigen::Vector3d c = Eigen::Vector3d::Zero();
-      for (const auto& p : cpts) c += p;
-      c /= static_cast<double>(cpts.size());
-      Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
-      double sq = 0.0;
-      for (const auto& p : cpts) {
-        const double dist = seg.plane.SignedDistance(p);
-        sq += dist * dist;
-        const Eigen::Vector3d d = (p - c) - dist * seg.plane.normal;
-        scatter += d * d.transpose();
-      }
-      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(scatter);
-      Eigen::Vector3d u = eig.eigenvectors().col(2);
-      Eigen::Index big;
-      u.cwiseAbs().maxCoeff(&big);
-      if (u(big) < 0) u = -u;  // canonical sign: deterministic frames
-      seg.frame = MakePlaneFrame(seg.plane, c, u);
-      seg.rms_distance_m = std::sqrt(sq / cpts.size());
-      seg.inlier_ids.reserve(comp.size());
-      seg.inlier_st.reserve(comp.size());
-      for (int k : comp) {
-        const int lm = remaining[inliers[k]];
-        lms[lm].plane_id = seg.id;
-        taken[lm] = 1;
-        seg.inlier_ids.push_back(lms[lm].id);
-        seg.inlier_st.push_back(seg.frame.ToPlane(lms[lm].x_in_world));
-      }
-      seg.polygon = options.concave_polygon
-                        ? OccupancyOutline(seg.inlier_st,
-                                           options.polygon_cell_factor * radius)
-                        : ConvexHull(seg.inlier_st);
-      report.inliers_per_plane.push_back(static_cast<int>(comp.size()));
-      if (options.absorb_consistent_points) {
-        const double k = options.covariance_sigmas * options.tracking_noise_px;
-        for (int lm : remaining) {
-          if (taken[lm]) continue;
-          const Eigen::Vector3d& x = lms[lm].x_in_world;
-          const double band = std::max(
-              thresholds[lm], CovarianceBand(lms[lm], seg.plane.normal, k));
-          if (std::abs(seg.plane.SignedDistance(x)) > band) continue;
-          const Eigen::Vector2d q = seg.frame.ToPlane(x);
-          if (DistanceToPolygon(seg.polygon, q) <= radius) {
-            taken[lm] = 1;
-            ++report.absorbed;
-          }
-        }
-      }
-      segments->push_back(std::move(seg));
-    }
-    if (accepted) {
-      failures = 0;
-    } else {
-      // No coherent region: a plane through clutter. Set its points aside
-      // so the next hypothesis differs.
-      ++failures;
-      ++report.rejected_hypotheses;
-      for (size_t k : inliers) taken[remaining[k]] = 1;
-    }
-    std::erase_if(remaining, [&](int i) { return taken[i] != 0; });
+    const Attempt result = TryHypothesis(attempt, &s);
+    if (result == Attempt::kExhausted) break;
+    failures = result == Attempt::kAccepted ? 0 : failures + 1;
+    std::erase_if(s.remaining, [&](int i) { return s.taken[i] != 0; });
   }
-
+  if (options.merge_coplanar) MergeCoplanar(&s);
   report.num_planes = static_cast<int>(segments->size());
   report.num_outliers = 0;
-  for (const auto& lm : lms) report.num_outliers += lm.plane_id < 0 ? 1 : 0;
+  for (const auto& lm : *landmarks) {
+    report.num_outliers += lm.plane_id < 0 ? 1 : 0;
+  }
   report.seconds = timer.ElapsedSeconds();
   return report;
 }

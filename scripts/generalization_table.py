@@ -1,0 +1,92 @@
+#!/usr/bin/env python3
+"""Collects the generalization set's eval JSONs into one JSON and a markdown table.
+
+usage: generalization_table.py OUTDIR CASE...   (CASE: "name world seed h pitch fps speed",
+as in scripts/generalization_set.sh). Writes OUTDIR/generalization.{json,md}.
+"""
+import json
+import os
+import sys
+from collections import Counter
+
+
+def load(path):
+    with open(path) as f:
+        return json.load(f)
+
+
+def sim_row(out, case):
+    name, world, seed, h, pitch, fps, speed = case.split()
+    e = load(os.path.join(out, f"eval_{name}.json"))
+    matched = [m for m in e["planes"]["matches"] if m["matched"]]
+    # A true plane claimed by two or more matched map planes is split.
+    per_true = Counter(m["true_id"] for m in matched)
+    observed = [t for t in e["true_planes"] if t["observed"]]
+    rel = e["point_error"]["all_landmarks"]["relative_percent"]
+    return {
+        "name": name, "world": world, "seed": int(seed), "camera_height_m": float(h),
+        "pitch_deg": float(pitch), "fps": float(fps), "speed_mps": float(speed),
+        "build_s": int(open(os.path.join(out, f"time_{name}.txt")).read()),
+        "fitted_planes": e["counts"]["fitted_planes"],
+        "observed_true_planes": len(observed),
+        "recovered_true_planes": sum(1 for t in observed if t["matched"]),
+        "split_true_planes": sum(1 for c in per_true.values() if c > 1),
+        "precision": e["planes"]["precision"],
+        "recall": e["planes"]["recall"],
+        "points": rel["count"],
+        "median_error_percent": rel["median"],
+        "p90_error_percent": rel["p90"],
+    }
+
+
+def real_row(out, name):
+    e = load(os.path.join(out, f"eval_{name}.json"))
+    row = {"name": name, "build_s": int(open(os.path.join(out, f"time_{name}.txt")).read()),
+           "eval_points": e}
+    p = os.path.join(out, f"evalplanes_{name}.json")
+    if os.path.exists(p):
+        row["eval_planes"] = load(p)
+    return row
+
+
+def find_stat(obj, want):
+    """First dict under obj holding 'median' and 'count' whose key path contains want."""
+    stack = [("", obj)]
+    while stack:
+        path, o = stack.pop(0)
+        if isinstance(o, dict):
+            if "median" in o and "count" in o and want in path:
+                return o
+            stack.extend((path + "." + k, v) for k, v in o.items())
+    return None
+
+
+def main():
+    out, cases = sys.argv[1], sys.argv[2:]
+    sims = [sim_row(out, c) for c in cases]
+    reals = [real_row(out, n) for n in ("desk_a", "desk_b", "castle")]
+    with open(os.path.join(out, "generalization.json"), "w") as f:
+        json.dump({"simulated": sims, "real": reals}, f, indent=1)
+    lines = ["| run | h m / pitch deg / fps | build s | map planes | true planes seen / recovered / split"
+             " | precision | points | median error % of distance (p90) |",
+             "|---|---|---|---|---|---|---|---|"]
+    for r in sims:
+        lines.append(
+            f"| {r['name'].split('_')[0]} seed {r['seed']} | {r['camera_height_m']:g} / {r['pitch_deg']:g} /"
+            f" {r['fps']:g} | {r['build_s']} | {r['fitted_planes']} | {r['observed_true_planes']} /"
+            f" {r['recovered_true_planes']} / {r['split_true_planes']} | {r['precision']:.2f} |"
+            f" {r['points']} | {r['median_error_percent']:.2f} ({r['p90_error_percent']:.2f}) |")
+    for r in reals:
+        rel = find_stat(r["eval_points"], "relative") or {}
+        ab = find_stat(r["eval_points"], "abs") or {}
+        med_mm = ab.get("median", float("nan")) * 1000
+        lines.append(
+            f"| {r['name']} | real | {r['build_s']} | - | - | - | {rel.get('count', '-')} |"
+            f" {rel.get('median', float('nan')):.2f} ({rel.get('p90', float('nan')):.2f}); {med_mm:.2f} mm |")
+    with open(os.path.join(out, "generalization.md"), "w") as f:
+        f.write("\n".join(lines) + "\n")
+    print("\n".join(lines))
+
+
+if __name__ == "__main__":
+    main()
