@@ -1,11 +1,10 @@
 // libFuzzer target: images through io/image_file (ReadImageFile, grey and colour).
 #include <cstddef>
 #include <cstdint>
+#include <opencv2/imgcodecs.hpp>
 #include <string_view>
 
 #include "fuzz/fuzz_util.h"
-#include <opencv2/imgcodecs.hpp>
-
 #include "monomap/io/image_file.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
