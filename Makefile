@@ -1,6 +1,9 @@
 # monomap: the two commands of the README.
 #   make demo   install missing Debian packages, build, run the demo
 #   make test   install missing Debian packages, build, run all tests
+#   make test-sanitize   the test suite under ASan+UBSan (build-asan)
+#   make fuzz   build the libFuzzer targets (build-fuzz), run each for
+#               FUZZ_SECONDS on fuzz/corpus/<target>; non-zero on a finding
 BUILD_DIR ?= build
 JOBS ?= $(shell nproc)
 DEMO_DIR ?= out/demo
@@ -16,9 +19,19 @@ DEB_PACKAGES = cmake ninja-build g++ pkg-config libopencv-dev libeigen3-dev \
   libroscpp-dev libtf2-ros-dev libstd-srvs-dev ros-core \
   libjs-three libjs-chart.js
 
+# Extra packages of `make fuzz` and `make test-sanitize` (clang 14 with its
+# libFuzzer and sanitizer runtimes).
+SANITIZE_PACKAGES = clang libclang-rt-14-dev
+ASAN_DIR ?= build-asan
+FUZZ_DIR ?= build-fuzz
+FUZZ_SECONDS ?= 60
+# Memory limit per fuzz input (MB): more than this is an OOM finding.
+FUZZ_RSS_MB ?= 2048
+FUZZ_TARGETS = camera_yaml camera_mount dataset feature_table image map ply
+
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
-.PHONY: deps configure build test demo bench clean
+.PHONY: deps sanitize-deps configure build test test-sanitize fuzz demo bench clean
 
 deps:
 	@missing=$$(for p in $(DEB_PACKAGES); do \
@@ -30,6 +43,9 @@ deps:
 	  DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -qq $$missing; \
 	fi
 
+sanitize-deps: deps
+	@$(MAKE) --no-print-directory deps DEB_PACKAGES="$(SANITIZE_PACKAGES)"
+
 configure: deps
 	@[ -f $(BUILD_DIR)/build.ninja ] || \
 	  cmake -S . -B $(BUILD_DIR) -G Ninja -DCMAKE_BUILD_TYPE=Release
@@ -39,6 +55,37 @@ build: configure
 
 test: build
 	cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS)
+
+# halt_on_error: the first sanitizer report fails the test.
+test-sanitize: sanitize-deps
+	@[ -f $(ASAN_DIR)/build.ninja ] || \
+	  cmake -S . -B $(ASAN_DIR) -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+	    -DMONOMAP_SANITIZE=ON -DMONOMAP_BUILD_BENCH=OFF
+	cmake --build $(ASAN_DIR) -j $(JOBS)
+	cd $(ASAN_DIR) && \
+	  ASAN_OPTIONS=halt_on_error=1:detect_leaks=1 \
+	  UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 \
+	  ctest --output-on-failure -j $(JOBS)
+
+# Each target runs FUZZ_SECONDS on a copy of its checked-in corpus (new
+# inputs land in $(FUZZ_DIR)/corpus, not in the source tree); crash files
+# go to $(FUZZ_DIR)/findings.
+fuzz: sanitize-deps
+	@[ -f $(FUZZ_DIR)/build.ninja ] || \
+	  CXX=clang++ cmake -S . -B $(FUZZ_DIR) -G Ninja \
+	    -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMONOMAP_BUILD_FUZZERS=ON \
+	    -DMONOMAP_BUILD_TESTS=OFF -DMONOMAP_BUILD_BENCH=OFF
+	cmake --build $(FUZZ_DIR) -j $(JOBS) --target \
+	  $(addsuffix _fuzzer,$(FUZZ_TARGETS))
+	@mkdir -p $(FUZZ_DIR)/findings; status=0; \
+	for t in $(FUZZ_TARGETS); do \
+	  mkdir -p $(FUZZ_DIR)/corpus/$$t; \
+	  echo "== $${t}_fuzzer: $(FUZZ_SECONDS) s"; \
+	  $(FUZZ_DIR)/fuzz/$${t}_fuzzer -max_total_time=$(FUZZ_SECONDS) \
+	    -timeout=10 -rss_limit_mb=$(FUZZ_RSS_MB) -print_final_stats=1 \
+	    -artifact_prefix=$(FUZZ_DIR)/findings/$${t}- \
+	    $(FUZZ_DIR)/corpus/$$t fuzz/corpus/$$t || status=1; \
+	done; exit $$status
 
 demo: build
 	$(BUILD_DIR)/src/monomap/exe/monomap demo -o $(DEMO_DIR)
