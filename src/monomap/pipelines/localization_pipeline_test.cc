@@ -126,7 +126,7 @@ TEST_F(LocalizationPipelineTest, TracksFromAGivenPoseAndReportsErrors) {
   EXPECT_DOUBLE_EQ(j["rmse_translation_m"].get<double>(), r.rmse_translation_m);
   ASSERT_EQ(j["steps"].size(), 10u);
   EXPECT_EQ(j["steps"][9]["particles"].get<int>(), r.steps[9].particles);
-  EXPECT_EQ(j["steps"][9].size(), 12u);
+  EXPECT_EQ(j["steps"][9].size(), 14u);
   // Without ground truth there are no error fields.
   Dataset no_truth = ds_;
   for (DatasetFrame& f : no_truth.frames) f.groundtruth_world_from_cam.reset();
