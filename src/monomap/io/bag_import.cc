@@ -224,6 +224,44 @@ std::optional<Rigid3d> MountFromTfStatic(BagMessages& bag,
   return std::nullopt;  // a cycle
 }
 
+}  // namespace
+
+cv::Mat RawImagePixels(const std::string& encoding, uint32_t width,
+                       uint32_t height, uint32_t step, const uint8_t* data,
+                       size_t size, const std::string& where) {
+  int type = 0;
+  if (encoding == "mono8") {
+    type = CV_8UC1;
+  } else if (encoding == "bgr8" || encoding == "rgb8") {
+    type = CV_8UC3;
+  } else {
+    throw InputError(where, "encoding",
+                     "'" + encoding +
+                         "' is not supported (mono8, bgr8, rgb8 or "
+                         "sensor_msgs/CompressedImage)");
+  }
+  const size_t row_bytes = size_t(width) * CV_ELEM_SIZE(type);
+  if (width == 0 || height == 0 || step < row_bytes ||
+      size < size_t(step) * height) {
+    throw InputError(where, "data",
+                     "holds " + std::to_string(size) + " bytes, too few for " +
+                         std::to_string(width) + "x" +
+                         std::to_string(height) + " " + encoding);
+  }
+  // The message's buffer viewed in place, then copied.
+  const cv::Mat view(int(height), int(width), type, const_cast<uint8_t*>(data),
+                     step);
+  cv::Mat pixels;
+  if (encoding == "rgb8") {
+    cv::cvtColor(view, pixels, cv::COLOR_RGB2BGR);
+  } else {
+    pixels = view.clone();
+  }
+  return pixels;
+}
+
+namespace {
+
 // An image message decoded: the pixels (for checks) and the file to write.
 struct DecodedImage {
   cv::Mat pixels;
@@ -233,34 +271,10 @@ struct DecodedImage {
 };
 
 DecodedImage DecodeRaw(const Image& msg, const std::string& where) {
-  int type = 0;
-  if (msg.encoding == "mono8") {
-    type = CV_8UC1;
-  } else if (msg.encoding == "bgr8" || msg.encoding == "rgb8") {
-    type = CV_8UC3;
-  } else {
-    throw InputError(where, "encoding",
-                     "'" + msg.encoding +
-                         "' is not supported (mono8, bgr8, rgb8 or "
-                         "sensor_msgs/CompressedImage)");
-  }
-  const size_t row_bytes = size_t(msg.width) * CV_ELEM_SIZE(type);
-  if (msg.width == 0 || msg.height == 0 || msg.step < row_bytes ||
-      msg.data.size() < size_t(msg.step) * msg.height) {
-    throw InputError(where, "data",
-                     "holds " + std::to_string(msg.data.size()) +
-                         " bytes, too few for " + std::to_string(msg.width) +
-                         "x" + std::to_string(msg.height) + " " + msg.encoding);
-  }
-  const cv::Mat view(int(msg.height), int(msg.width), type,
-                     const_cast<uint8_t*>(msg.data.data()), msg.step);
   DecodedImage d;
   d.encoding = msg.encoding;
-  if (msg.encoding == "rgb8") {
-    cv::cvtColor(view, d.pixels, cv::COLOR_RGB2BGR);
-  } else {
-    d.pixels = view.clone();
-  }
+  d.pixels = RawImagePixels(msg.encoding, msg.width, msg.height, msg.step,
+                            msg.data.data(), msg.data.size(), where);
   d.extension = ".png";
   if (!cv::imencode(".png", d.pixels, d.encoded)) {
     throw OutputError(where + ": PNG encoding failed");

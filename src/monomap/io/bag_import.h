@@ -20,6 +20,8 @@
 #include <string>
 #include <vector>
 
+#include <opencv2/core.hpp>
+
 #include "monomap/camera/camera.h"
 #include "monomap/geometry/rigid3.h"
 
@@ -137,6 +139,14 @@ std::string CanonicalType(const std::string& type);
 // ROS camera_info -> Camera. Throws InputError naming `where` and the field
 // for a missing calibration or an unsupported lens model.
 Camera CameraFromInfo(const CameraInfo& info, const std::string& where);
+
+// The pixels of a raw sensor_msgs/Image (mono8 -> 8-bit grey, bgr8 and
+// rgb8 -> BGR), copied out of `data` (rows may be padded to `step`).
+// Shared by the importers and the ROS node. Throws InputError naming
+// `where` and the encoding, or the size that does not fit.
+cv::Mat RawImagePixels(const std::string& encoding, uint32_t width,
+                       uint32_t height, uint32_t step, const uint8_t* data,
+                       size_t size, const std::string& where);
 
 // Reads everything from `messages` and writes the dataset to `out_dir`
 // atomically (replacing it only on success). Throws InputError naming the
