@@ -324,11 +324,8 @@ nlohmann::json RunSeed(const SweepOptions& o, const std::string& world,
     lo.state = LocalizationState::kPlanar;
     lo.init.kind =
         kidnap || o.track ? LocalizationInit::kPose : LocalizationInit::kGlobal;
-    lo.mcl.num_particles = configs[c].particles;
+    lo.mcl.SetParticleBudget(configs[c].particles);
     lo.mcl.use_kld = !o.fixed_count;
-    lo.mcl.kld.max_particles = configs[c].particles;
-    lo.mcl.kld.min_particles =
-        std::min(lo.mcl.kld.min_particles, lo.mcl.num_particles);
     lo.seed = static_cast<uint64_t>(seed);
     if (o.sigma > 0) lo.mcl.measurement.sigma = o.sigma;
     if (o.refine_width == 0) lo.mcc.refine_estimate = false;

@@ -93,7 +93,7 @@ SessionOptions MakeOptions(const ReplayArgs& a) {
   o.localizer.method = ParseLocalizationMethod(a.method);
   o.localizer.state = ParseLocalizationState(a.state);
   o.localizer.init.kind = ParseLocalizationInit(a.init);
-  o.localizer.mcl.num_particles = a.particles;
+  o.localizer.mcl.SetParticleBudget(a.particles);
   o.localizer.seed = a.seed;
   o.max_pending_frames = a.max_pending;
   o.output_particles = false;

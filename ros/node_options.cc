@@ -67,10 +67,7 @@ void ReadLocalizerOptions(const ros::NodeHandle& pnh, LocalizerOptions* o) {
   pnh.param("init_spread_m", o->init.spread_m, o->init.spread_m);
   pnh.param("init_spread_deg", o->init.spread_deg, o->init.spread_deg);
   pnh.param("particles", o->mcl.num_particles, o->mcl.num_particles);
-  // The budget: the initial count and KLD-sampling's maximum.
-  o->mcl.kld.max_particles = o->mcl.num_particles;
-  o->mcl.kld.min_particles =
-      std::min(o->mcl.kld.min_particles, o->mcl.num_particles);
+  o->mcl.SetParticleBudget(o->mcl.num_particles);
   pnh.param("mcc_top_k", o->mcc.top_k, o->mcc.top_k);
   pnh.param("relocalize_ncc_drop", o->recovery.relocalize_ncc_drop,
             o->recovery.relocalize_ncc_drop);

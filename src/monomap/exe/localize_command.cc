@@ -92,11 +92,7 @@ LocalizerOptions ResolveOptions(const LocalizeArgs& a) {
     }
     options.init.pose = ParsePose(a.init_pose, "--init-pose");
   }
-  // The budget: the initial count and KLD-sampling's maximum.
-  const int particles = options.mcl.num_particles;
-  options.mcl.kld.max_particles = particles;
-  options.mcl.kld.min_particles =
-      std::min(options.mcl.kld.min_particles, particles);
+  options.mcl.SetParticleBudget(options.mcl.num_particles);
   if (!a.mcc_size.empty()) {
     ParseImageSize(a.mcc_size, "--mcc-size", &options.mcc.corrector.width,
                    &options.mcc.corrector.height);

@@ -41,6 +41,12 @@ LocalizationInit ParseLocalizationInit(const std::string& s) {
   throw OptionsError("init: '" + s + "' is not global or pose");
 }
 
+void MclOptions::SetParticleBudget(int particles) {
+  num_particles = particles;
+  kld.max_particles = particles;
+  kld.min_particles = std::min(kld.min_particles, particles);
+}
+
 void MclOptions::Check() const {
   CheckOption(num_particles >= 1, "num_particles", "must be >= 1");
   if (use_kld) kld.Check();

@@ -54,6 +54,9 @@ struct MclOptions {
   double cluster_radius_m = 0.15;
   double cluster_angle_deg = 15.0;
 
+  // A particle budget, as `localize --particles` means it: the initial
+  // count and KLD-sampling's maximum (its minimum no higher).
+  void SetParticleBudget(int particles);
   void Check() const;
 };
 

@@ -99,10 +99,7 @@ DemoLocalization RunDemoLocalization(const Map& map,
     lo.method = method;
     lo.state = LocalizationState::kPlanar;
     lo.init.kind = LocalizationInit::kGlobal;
-    lo.mcl.num_particles = options.particles;
-    lo.mcl.kld.max_particles = options.particles;
-    lo.mcl.kld.min_particles =
-        std::min(lo.mcl.kld.min_particles, options.particles);
+    lo.mcl.SetParticleBudget(options.particles);
     lo.seed = mapping_sim.seed;
     DemoLocalizationRun run;
     run.name = method == LocalizationMethod::kMcc ? "MCC" : "MCL";
