@@ -93,6 +93,8 @@ void AddMappingOptions(CLI::App* cmd, BuildArgs* a) {
   cmd->add_option("--ransac-iterations", o.planes.ransac_iterations,
                   "RANSAC hypotheses per plane")
       ->capture_default_str();
+  cmd->add_flag("--merge-coplanar", o.planes.merge_coplanar,
+                "Merge plane segments that are one physical plane");
   cmd->add_option("--keyframe-interval", o.keyframes.interval,
                   "Bundle-adjust every n-th frame (1: all frames)")
       ->capture_default_str();

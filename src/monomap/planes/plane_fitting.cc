@@ -9,6 +9,7 @@
 #include <unordered_map>
 
 #include "monomap/geometry/polygon.h"
+#include "monomap/util/angles.h"
 #include "monomap/util/error.h"
 #include "monomap/util/progress.h"
 #include "monomap/util/stats.h"
@@ -161,10 +162,12 @@ std::vector<std::vector<int>> ConnectedComponents(
 }
 
 // Outline of the occupancy grid of the points (cell size `cell`), closed
-// morphologically so sampling gaps do not punch holes; falls back to the
-// convex hull when the grid is degenerate.
-Polygon2d OccupancyOutline(const std::vector<Eigen::Vector2d>& st,
-                           double cell) {
+// morphologically so sampling gaps do not punch holes, and gaps up to
+// `bridge` wide are filled (merged segments: the untextured stretch between
+// two pieces of one wall is wall too); falls back to the convex hull when
+// the grid is degenerate.
+Polygon2d OccupancyOutline(const std::vector<Eigen::Vector2d>& st, double cell,
+                           double bridge = 0.0) {
   Eigen::Vector2d lo = st[0], hi = st[0];
   for (const auto& p : st) {
     lo = lo.cwiseMin(p);
@@ -176,7 +179,10 @@ Polygon2d OccupancyOutline(const std::vector<Eigen::Vector2d>& st,
     const double extent = hi(a) - lo(a);
     lo(a) -= 0.5 * ((std::floor(extent / cell) + 1) * cell - extent);
   }
-  const int margin = 2;
+  // Closing radius in cells: one cell, or half the bridged gap plus one.
+  const int close_r =
+      std::max(1, static_cast<int>(std::ceil(0.5 * bridge / cell)) + 1);
+  const int margin = close_r + 1;
   const double cols_d = (hi.x() - lo.x()) / cell + 2 * margin + 1;
   const double rows_d = (hi.y() - lo.y()) / cell + 2 * margin + 1;
   if (cols_d * rows_d > 2.5e5) return ConvexHull(st);  // too fine: stay cheap
@@ -188,7 +194,8 @@ Polygon2d OccupancyOutline(const std::vector<Eigen::Vector2d>& st,
     cells(r, c) = 255;
   }
   cv::morphologyEx(cells, cells, cv::MORPH_CLOSE,
-                   cv::getStructuringElement(cv::MORPH_RECT, {3, 3}));
+                   cv::getStructuringElement(
+                       cv::MORPH_RECT, {2 * close_r + 1, 2 * close_r + 1}));
   // Contours pass through boundary pixel centres; upsampling the cells
   // puts them 1/8 cell inside the occupied area instead of 1/2.
   constexpr int kUp = 4;
@@ -307,24 +314,30 @@ void RefineHypothesis(const FitState& s, const PlaneEstimator& estimator,
 }
 
 // A "ghost": nearly the same plane as an accepted segment, made of the
-// points just outside that segment's threshold (its noisier points).
-// They are outliers of the real plane, not a second surface.
+// points just outside that segment's threshold (its noisier points). They
+// are outliers of the real plane, not a second surface. Only the points over
+// the segment's polygon count: a surface beside it, such as a door leaf
+// recessed a few cm in its wall, is a plane of its own.
 bool IsGhost(const FitState& s, const Plane& plane,
              const std::vector<size_t>& inliers) {
-  bool ghost = false;
   for (const PlaneSegment& seg : *s.segments) {
-    if (PlaneAngle(seg.plane, plane) >
-        s.options.ghost_max_angle_deg * M_PI / 180.0) {
+    if (PlaneAngle(seg.plane, plane) > DegToRad(s.options.ghost_max_angle_deg)) {
       continue;
     }
     double dist = 0.0, thr = 0.0;
+    size_t over = 0;
     for (size_t k : inliers) {
+      if (!PointInPolygon(seg.polygon, seg.frame.ToPlane(s.pts[k]))) continue;
+      ++over;
       dist += std::abs(seg.plane.SignedDistance(s.pts[k]));
       thr += 1.0 / s.inv_thr[k];
     }
-    if (dist < s.options.ghost_distance_factor * thr) ghost = true;
+    if (2 * over >= inliers.size() &&
+        dist < s.options.ghost_distance_factor * thr) {
+      return true;
+    }
   }
-  return ghost;
+  return false;
 }
 
 // Splits the inliers into connected regions of the plane; *radius is the
@@ -533,26 +546,37 @@ double PolygonGap(const PlaneSegment& a, const PlaneSegment& b) {
   return gap;
 }
 
+// A segment while merging: its inlier positions, its id as fitted, and the
+// widest gap between merged pieces its polygon must bridge.
+struct MergeItem {
+  std::vector<Eigen::Vector3d> pts;
+  int fitted_id = 0;
+  double bridge_m = 0.0;
+};
+
 // Whether a and b are one physical plane: normals and offsets agree within
 // the noise (centroids and each one's inliers against the other's fit) and
-// their supports touch. Fills the merge record's angle and offset.
+// their supports touch. Fills the merge record's angle and offset, and *gap.
 bool SameSurface(const PlaneFittingOptions& o, const PlaneSegment& a,
-                 const std::vector<Eigen::Vector3d>& pa, const PlaneSegment& b,
-                 const std::vector<Eigen::Vector3d>& pb,
-                 PlaneFittingReport::Merge* m) {
-  m->angle_deg = PlaneAngle(a.plane, b.plane) * 180.0 / M_PI;
+                 const MergeItem& ia, const PlaneSegment& b,
+                 const MergeItem& ib, PlaneFittingReport::Merge* m,
+                 double* gap) {
+  m->angle_deg = RadToDeg(PlaneAngle(a.plane, b.plane));
   if (m->angle_deg > o.merge_max_angle_deg) return false;
   m->offset_m =
       std::max({std::abs(b.plane.SignedDistance(a.frame.origin)),
                 std::abs(a.plane.SignedDistance(b.frame.origin)),
-                MedianDistance(b.plane, pa), MedianDistance(a.plane, pb)});
+                MedianDistance(b.plane, ia.pts), MedianDistance(a.plane, ib.pts)});
   if (m->offset_m > o.merge_max_offset_m) return false;
-  return PolygonGap(a, b) <= o.merge_max_gap_m;
+  *gap = PolygonGap(a, b);
+  return *gap <= o.merge_max_gap_m;
 }
 
-// Refits seg (plane, frame, in-plane coordinates, polygon) to its points.
-void RefitSegment(const FitState& s, const std::vector<Eigen::Vector3d>& pts,
+// Refits seg (plane, frame, in-plane coordinates, polygon) to its points;
+// the polygon bridges gaps up to item.bridge_m.
+void RefitSegment(const FitState& s, const MergeItem& item,
                   PlaneSegment* seg) {
+  const std::vector<Eigen::Vector3d>& pts = item.pts;
   seg->plane = FitPlaneLeastSquares(pts);
   OrientPlane(s.camera_centers, &seg->plane);
   SetSegmentFrame(pts, seg);
@@ -567,34 +591,36 @@ void RefitSegment(const FitState& s, const std::vector<Eigen::Vector3d>& pts,
         o.connectivity_factor * MedianNearestNeighbourSpacing(seg->inlier_st),
         o.min_connectivity_radius_m, o.max_connectivity_radius_m);
   }
-  seg->polygon =
-      o.concave_polygon
-          ? OccupancyOutline(seg->inlier_st, o.polygon_cell_factor * radius)
-          : ConvexHull(seg->inlier_st);
+  seg->polygon = o.concave_polygon
+                     ? OccupancyOutline(seg->inlier_st,
+                                        o.polygon_cell_factor * radius,
+                                        item.bridge_m)
+                     : ConvexHull(seg->inlier_st);
 }
 
 // Merges the first pair of segments that are one surface; false if none.
-bool MergeOnePair(FitState* s, std::vector<std::vector<Eigen::Vector3d>>* pts,
-                  std::vector<int>* fitted_id) {
+bool MergeOnePair(FitState* s, std::vector<MergeItem>* items) {
   std::vector<PlaneSegment>& segs = *s->segments;
   for (size_t i = 0; i < segs.size(); ++i) {
     for (size_t j = i + 1; j < segs.size(); ++j) {
       PlaneFittingReport::Merge m;
-      if (!SameSurface(s->options, segs[i], (*pts)[i], segs[j], (*pts)[j],
-                       &m)) {
+      MergeItem& a = (*items)[i];
+      const MergeItem& b = (*items)[j];
+      double gap = 0.0;
+      if (!SameSurface(s->options, segs[i], a, segs[j], b, &m, &gap)) {
         continue;
       }
-      m.kept_id = (*fitted_id)[i];
-      m.merged_id = (*fitted_id)[j];
+      m.kept_id = a.fitted_id;
+      m.merged_id = b.fitted_id;
       s->report->merges.push_back(m);
       segs[i].inlier_ids.insert(segs[i].inlier_ids.end(),
                                 segs[j].inlier_ids.begin(),
                                 segs[j].inlier_ids.end());
-      (*pts)[i].insert((*pts)[i].end(), (*pts)[j].begin(), (*pts)[j].end());
-      RefitSegment(*s, (*pts)[i], &segs[i]);
+      a.pts.insert(a.pts.end(), b.pts.begin(), b.pts.end());
+      a.bridge_m = std::max({a.bridge_m, b.bridge_m, gap});
+      RefitSegment(*s, a, &segs[i]);
       segs.erase(segs.begin() + j);
-      pts->erase(pts->begin() + j);
-      fitted_id->erase(fitted_id->begin() + j);
+      items->erase(items->begin() + j);
       return true;
     }
   }
@@ -609,13 +635,11 @@ void MergeCoplanar(FitState* s) {
   for (int i = 0; i < static_cast<int>(s->lms.size()); ++i) {
     index[s->lms[i].id] = i;
   }
-  std::vector<std::vector<Eigen::Vector3d>> pts;
-  std::vector<int> fitted_id;
+  std::vector<MergeItem> items;
   for (const PlaneSegment& seg : segs) {
-    pts.push_back(InlierPoints(*s, index, seg));
-    fitted_id.push_back(seg.id);
+    items.push_back({InlierPoints(*s, index, seg), seg.id, 0.0});
   }
-  while (MergeOnePair(s, &pts, &fitted_id)) {
+  while (MergeOnePair(s, &items)) {
   }
   s->report->inliers_per_plane.clear();
   for (size_t k = 0; k < segs.size(); ++k) {
