@@ -59,6 +59,19 @@ nlohmann::json ToJson(const StructureAccuracy& a) {
                  {"precision", a.precision},
                  {"recall", a.recall}};
   j["true_planes"] = true_planes;
+  const AreaCoverage& c = a.coverage;
+  nlohmann::json area_planes = nlohmann::json::array();
+  for (const PlaneCoverage& p : c.planes) {
+    area_planes.push_back({{"true_id", p.true_id},
+                           {"seen_area_m2", p.seen_area_m2},
+                           {"recovered_area_m2", p.recovered_area_m2}});
+  }
+  j["area"] = {{"seen_area_m2", c.seen_area_m2},
+               {"recovered_area_m2", c.recovered_area_m2},
+               {"area_recall", c.area_recall},
+               {"large_planes_seen", c.large_planes_seen},
+               {"large_planes_recovered", c.large_planes_recovered},
+               {"planes", area_planes}};
   return j;
 }
 
@@ -135,6 +148,13 @@ std::string FormatTable(const StructureAccuracy& a) {
                 matched_fitted, a.fitted_planes, 100 * a.recall,
                 matched_observed, a.observed_true_planes);
   std::string out = buf;
+  const AreaCoverage& c = a.coverage;
+  std::snprintf(buf, sizeof(buf),
+                "area recovered %.1f%% (%.2f of %.2f m^2 seen); large "
+                "planes recovered %d of %d\n",
+                100 * c.area_recall, c.recovered_area_m2, c.seen_area_m2,
+                c.large_planes_recovered, c.large_planes_seen);
+  out += buf;
   out +=
       Header() + Row("all abs (mm)", a.point_error_all.absolute_m, 1e3) +
       Row("all rel (%)", a.point_error_all.relative_percent, 1.0) +
@@ -281,7 +301,13 @@ nlohmann::json ToJson(const StructureAccuracyOptions& o) {
           {"max_match_offset_m", o.max_match_offset_m},
           {"polygon_margin_m", o.polygon_margin_m},
           {"min_observed_landmarks", o.min_observed_landmarks},
-          {"observed_distance_m", o.observed_distance_m}};
+          {"observed_distance_m", o.observed_distance_m},
+          {"coverage",
+           {{"sample_spacing_m", o.coverage.sample_spacing_m},
+            {"max_views", o.coverage.max_views},
+            {"max_angle_deg", o.coverage.max_angle_deg},
+            {"max_distance_m", o.coverage.max_distance_m},
+            {"large_plane_area_m2", o.coverage.large_plane_area_m2}}}};
 }
 
 }  // namespace monomap

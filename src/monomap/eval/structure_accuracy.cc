@@ -22,6 +22,7 @@ void StructureAccuracyOptions::Check() const {
               "must be at least 1");
   CheckOption(observed_distance_m > 0 && std::isfinite(observed_distance_m),
               "structure.observed_distance_m", "must be positive");
+  coverage.Check();
 }
 
 namespace {
@@ -207,6 +208,8 @@ StructureAccuracy EvaluateStructure(const Map& map, const Map& truth,
                          ? 0.0
                          : static_cast<double>(matched_fitted) /
                                static_cast<double>(map.planes.size());
+  result.coverage =
+      MeasureAreaCoverage(map, truth, truth_from_map, options.coverage);
   result.recall =
       result.observed_true_planes == 0
           ? 0.0

@@ -6,6 +6,7 @@
 
 #include <vector>
 
+#include "monomap/eval/area_coverage.h"
 #include "monomap/eval/point_accuracy.h"
 #include "monomap/geometry/rigid3.h"
 #include "monomap/map/map.h"
@@ -27,6 +28,8 @@ struct StructureAccuracyOptions {
   // Distance (m) of a landmark to its true plane to count towards
   // min_observed_landmarks.
   double observed_distance_m = 0.05;
+  // How the seen area and the area the planes recover are measured.
+  AreaCoverageOptions coverage;
 
   // Throws OptionsError on a value that makes no sense.
   void Check() const;
@@ -92,6 +95,9 @@ struct StructureAccuracy {
 
   // One per true plane, in the truth's order.
   std::vector<TruePlaneResult> true_plane_results;
+  // Seen and recovered area of the true planes (coverage.planes is in the
+  // truth's order too).
+  AreaCoverage coverage;
 };
 
 // Compares `map` (map.planes and the landmarks' plane_id) with the true

@@ -1,0 +1,163 @@
+#include "monomap/eval/area_coverage.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "monomap/geometry/polygon.h"
+#include "monomap/util/angles.h"
+#include "monomap/util/error.h"
+
+namespace monomap {
+
+void AreaCoverageOptions::Check() const {
+  CheckOption(sample_spacing_m > 0 && std::isfinite(sample_spacing_m),
+              "coverage.sample_spacing_m", "must be positive");
+  CheckOption(max_views >= 1, "coverage.max_views", "must be at least 1");
+  CheckOption(max_angle_deg > 0 && max_angle_deg < 90,
+              "coverage.max_angle_deg", "must be in (0, 90)");
+  CheckOption(max_distance_m > 0 && std::isfinite(max_distance_m),
+              "coverage.max_distance_m", "must be positive");
+  CheckOption(large_plane_area_m2 >= 0 && std::isfinite(large_plane_area_m2),
+              "coverage.large_plane_area_m2", "must not be negative");
+}
+
+namespace {
+
+// Grid samples (cell centres, spacing h) inside a plane's polygon, in the
+// truth's world frame.
+std::vector<Eigen::Vector3d> SamplePlane(const TexturedPlane& p, double h) {
+  std::vector<Eigen::Vector3d> out;
+  if (p.polygon.size() < 3) return out;  // unbounded: no area to count
+  Eigen::Vector2d lo = p.polygon[0], hi = p.polygon[0];
+  for (const auto& v : p.polygon) {
+    lo = lo.cwiseMin(v);
+    hi = hi.cwiseMax(v);
+  }
+  for (double s = lo.x() + 0.5 * h; s < hi.x(); s += h) {
+    for (double t = lo.y() + 0.5 * h; t < hi.y(); t += h) {
+      if (PointInPolygon(p.polygon, {s, t})) out.push_back(p.frame.ToWorld({s, t}));
+    }
+  }
+  return out;
+}
+
+// Whether the segment from the camera centre c to x crosses a true plane
+// other than `self` inside its polygon before reaching x.
+bool Occluded(const std::vector<TexturedPlane>& truth, size_t self,
+              const Eigen::Vector3d& c, const Eigen::Vector3d& x) {
+  const Eigen::Vector3d d = x - c;
+  for (size_t k = 0; k < truth.size(); ++k) {
+    if (k == self) continue;
+    const Plane& pl = truth[k].plane;
+    const double denom = pl.normal.dot(d);
+    if (std::abs(denom) < 1e-12) continue;
+    const double t = -pl.SignedDistance(c) / denom;
+    // Stop short of x: planes meeting at x's edge do not hide it.
+    if (t <= 1e-6 || t >= 1.0 - 1e-3) continue;
+    const TexturedPlane& q = truth[k];
+    if (q.polygon.size() < 3 || PointInPolygon(q.polygon, q.frame.ToPlane(c + t * d))) {
+      return true;
+    }
+  }
+  return false;
+}
+
+// A camera that tests visibility: its pose and centre in the truth's frame.
+struct View {
+  Rigid3d cam_from_truth;
+  Eigen::Vector3d center_in_truth;
+};
+
+bool Seen(const Camera& camera, const std::vector<View>& views,
+          const std::vector<TexturedPlane>& truth, size_t self,
+          const Eigen::Vector3d& x) {
+  for (const View& view : views) {
+    const Eigen::Vector3d x_in_cam = view.cam_from_truth * x;
+    if (x_in_cam.z() <= 1e-3) continue;
+    const Eigen::Vector2d xn = x_in_cam.head<2>() / x_in_cam.z();
+    if (!camera.InImage(camera.PinholeFromNormalized(xn))) continue;
+    if (!Occluded(truth, self, view.center_in_truth, x)) return true;
+  }
+  return false;
+}
+
+// Whether a fitted plane (map frame) of about the same orientation as the
+// true normal passes near x_in_map and its polygon contains x_in_map.
+bool Recovered(const Map& map, const Eigen::Vector3d& normal_in_map,
+               const Eigen::Vector3d& x_in_map,
+               const AreaCoverageOptions& o) {
+  const double cos_max = std::cos(DegToRad(o.max_angle_deg));
+  for (const TexturedPlane& p : map.planes) {
+    if (std::abs(p.plane.normal.dot(normal_in_map)) < cos_max) continue;
+    if (std::abs(p.plane.SignedDistance(x_in_map)) > o.max_distance_m) continue;
+    if (PointInPolygon(p.polygon, p.frame.ToPlane(x_in_map))) return true;
+  }
+  return false;
+}
+
+// At most max_views poses of the trajectory, evenly spread.
+std::vector<View> Views(const Map& map, const Rigid3d& truth_from_map,
+                        int max_views) {
+  std::vector<View> views;
+  const size_t n = map.trajectory.size();
+  const size_t step = std::max<size_t>(1, (n + max_views - 1) / max_views);
+  for (size_t i = 0; i < n; i += step) {
+    const Rigid3d truth_from_cam =
+        truth_from_map * map.trajectory[i].world_from_cam;
+    views.push_back({truth_from_cam.Inverse(), truth_from_cam.translation});
+  }
+  return views;
+}
+
+PlaneCoverage CoverPlane(const Map& map, const Map& truth, size_t j,
+                         const Rigid3d& truth_from_map,
+                         const std::vector<View>& views,
+                         const AreaCoverageOptions& o) {
+  const TexturedPlane& p = truth.planes[j];
+  const std::vector<Eigen::Vector3d> samples = SamplePlane(p, o.sample_spacing_m);
+  const Rigid3d map_from_truth = truth_from_map.Inverse();
+  const Eigen::Vector3d normal_in_map = map_from_truth.rotation * p.plane.normal;
+  int seen = 0, recovered = 0;
+  for (const Eigen::Vector3d& x : samples) {
+    if (!Seen(map.camera, views, truth.planes, j, x)) continue;
+    ++seen;
+    recovered += Recovered(map, normal_in_map, map_from_truth * x, o) ? 1 : 0;
+  }
+  const double cell = o.sample_spacing_m * o.sample_spacing_m;
+  return {p.id, seen * cell, recovered * cell};
+}
+
+}  // namespace
+
+AreaCoverage MeasureAreaCoverage(const Map& map, const Map& truth,
+                                 const Rigid3d& truth_from_map,
+                                 const AreaCoverageOptions& options) {
+  options.Check();
+  const std::vector<View> views =
+      Views(map, truth_from_map, options.max_views);
+  AreaCoverage result;
+  result.planes.resize(truth.planes.size());
+  tbb::parallel_for(size_t{0}, truth.planes.size(), [&](size_t j) {
+    result.planes[j] = CoverPlane(map, truth, j, truth_from_map, views, options);
+  });
+  for (const PlaneCoverage& c : result.planes) {
+    result.seen_area_m2 += c.seen_area_m2;
+    result.recovered_area_m2 += c.recovered_area_m2;
+    if (c.seen_area_m2 < options.large_plane_area_m2 || c.seen_area_m2 <= 0) {
+      continue;
+    }
+    ++result.large_planes_seen;
+    if (c.recovered_area_m2 >= 0.5 * c.seen_area_m2) {
+      ++result.large_planes_recovered;
+    }
+  }
+  if (result.seen_area_m2 > 0) {
+    result.area_recall = result.recovered_area_m2 / result.seen_area_m2;
+  }
+  return result;
+}
+
+}  // namespace monomap

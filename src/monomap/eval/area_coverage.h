@@ -1,0 +1,62 @@
+// How much of the seen true structure a map's planes cover (issue 18's
+// "area of the seen structure recovered"). The true planes are sampled on a
+// grid; a sample is seen if some camera of the map's trajectory has it in
+// its image, in front and not hidden by another true plane; it is recovered
+// if a fitted plane of the same orientation passes near it and its polygon
+// contains it.
+#pragma once
+
+#include <vector>
+
+#include "monomap/geometry/rigid3.h"
+#include "monomap/map/map.h"
+
+namespace monomap {
+
+struct AreaCoverageOptions {
+  // Grid spacing (m) of the samples on each true plane.
+  double sample_spacing_m = 0.05;
+  // At most this many trajectory poses test visibility (evenly spread): the
+  // cost grows with samples x poses x planes.
+  int max_views = 60;
+  // A fitted plane covers a sample within this angle (deg) of the true
+  // plane's normal, the same bound as a plane match in eval structure.
+  double max_angle_deg = 2.0;
+  // ... and within this distance (m) of the sample.
+  double max_distance_m = 0.03;
+  // True planes with at least this much seen area (m^2) are "large": the
+  // issue asks that 90 % of them be recovered.
+  double large_plane_area_m2 = 1.0;
+
+  // Throws OptionsError on a value that makes no sense.
+  void Check() const;
+};
+
+// One true plane: its seen and recovered area.
+struct PlaneCoverage {
+  int true_id = 0;
+  double seen_area_m2 = 0.0;
+  double recovered_area_m2 = 0.0;
+};
+
+struct AreaCoverage {
+  double seen_area_m2 = 0.0;
+  double recovered_area_m2 = 0.0;
+  // recovered / seen (0 when nothing was seen).
+  double area_recall = 0.0;
+  // True planes with seen_area_m2 >= large_plane_area_m2, and how many of
+  // them have at least half of their seen area recovered.
+  int large_planes_seen = 0;
+  int large_planes_recovered = 0;
+  std::vector<PlaneCoverage> planes;  // in the truth's order
+};
+
+// Coverage of `truth`'s planes by `map`'s planes, seen from map.trajectory
+// through map.camera (its pinhole model: the image bounds matter, not the
+// distortion). truth_from_map takes map coordinates to truth coordinates.
+// Throws OptionsError on bad options.
+AreaCoverage MeasureAreaCoverage(const Map& map, const Map& truth,
+                                 const Rigid3d& truth_from_map,
+                                 const AreaCoverageOptions& options);
+
+}  // namespace monomap
