@@ -161,41 +161,11 @@ std::vector<std::vector<int>> ConnectedComponents(
   return comps;
 }
 
-// Outline of the occupancy grid of the points (cell size `cell`), closed
-// morphologically so sampling gaps do not punch holes, and gaps up to
-// `bridge` wide are filled (merged segments: the untextured stretch between
-// two pieces of one wall is wall too); falls back to the convex hull when
-// the grid is degenerate.
-Polygon2d OccupancyOutline(const std::vector<Eigen::Vector2d>& st, double cell,
-                           double bridge = 0.0) {
-  Eigen::Vector2d lo = st[0], hi = st[0];
-  for (const auto& p : st) {
-    lo = lo.cwiseMin(p);
-    hi = hi.cwiseMax(p);
-  }
-  // Centre the grid on the points so the cells overhang equally on both
-  // sides.
-  for (int a = 0; a < 2; ++a) {
-    const double extent = hi(a) - lo(a);
-    lo(a) -= 0.5 * ((std::floor(extent / cell) + 1) * cell - extent);
-  }
-  // Closing radius in cells: one cell, or half the bridged gap plus one.
-  const int close_r =
-      std::max(1, static_cast<int>(std::ceil(0.5 * bridge / cell)) + 1);
-  const int margin = close_r + 1;
-  const double cols_d = (hi.x() - lo.x()) / cell + 2 * margin + 1;
-  const double rows_d = (hi.y() - lo.y()) / cell + 2 * margin + 1;
-  if (cols_d * rows_d > 2.5e5) return ConvexHull(st);  // too fine: stay cheap
-  cv::Mat1b cells =
-      cv::Mat1b::zeros(static_cast<int>(rows_d), static_cast<int>(cols_d));
-  for (const auto& p : st) {
-    const int c = static_cast<int>((p.x() - lo.x()) / cell) + margin;
-    const int r = static_cast<int>((p.y() - lo.y()) / cell) + margin;
-    cells(r, c) = 255;
-  }
-  cv::morphologyEx(cells, cells, cv::MORPH_CLOSE,
-                   cv::getStructuringElement(
-                       cv::MORPH_RECT, {2 * close_r + 1, 2 * close_r + 1}));
+// Outer outline of the set cells (the grid's cell (r, c) covers plane
+// coordinates lo + cell * (c - margin, r - margin) and one cell more);
+// empty if there is none worth a polygon.
+Polygon2d OutlineOfCells(const cv::Mat1b& cells, const Eigen::Vector2d& lo,
+                         double cell, int margin) {
   // Contours pass through boundary pixel centres; upsampling the cells
   // puts them 1/8 cell inside the occupied area instead of 1/2.
   constexpr int kUp = 4;
@@ -203,14 +173,14 @@ Polygon2d OccupancyOutline(const std::vector<Eigen::Vector2d>& st, double cell,
   cv::resize(cells, mask, {}, kUp, kUp, cv::INTER_NEAREST);
   std::vector<std::vector<cv::Point>> contours;
   cv::findContours(mask, contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_SIMPLE);
-  if (contours.empty()) return ConvexHull(st);
+  if (contours.empty()) return {};
   const auto largest = std::max_element(
       contours.begin(), contours.end(), [](const auto& a, const auto& b) {
         return std::abs(cv::contourArea(a)) < std::abs(cv::contourArea(b));
       });
   std::vector<cv::Point> simple;
   cv::approxPolyDP(*largest, simple, 0.5 * kUp, true);
-  if (simple.size() < 3) return ConvexHull(st);
+  if (simple.size() < 3) return {};
   // The contour runs through the centres of the boundary pixels: move each
   // vertex half a pixel outwards (miter offset) onto the pixel edges.
   Polygon2d px;
@@ -232,6 +202,80 @@ Polygon2d OccupancyOutline(const std::vector<Eigen::Vector2d>& st, double cell,
   }
   if (PolygonArea(poly) < 0) std::reverse(poly.begin(), poly.end());
   return poly;
+}
+
+// Outline of the occupancy grid of the points (cell size `cell`), closed
+// morphologically so sampling gaps do not punch holes; falls back to the
+// convex hull when the grid is degenerate.
+Polygon2d OccupancyOutline(const std::vector<Eigen::Vector2d>& st,
+                           double cell) {
+  Eigen::Vector2d lo = st[0], hi = st[0];
+  for (const auto& p : st) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  // Centre the grid on the points so the cells overhang equally on both
+  // sides.
+  for (int a = 0; a < 2; ++a) {
+    const double extent = hi(a) - lo(a);
+    lo(a) -= 0.5 * ((std::floor(extent / cell) + 1) * cell - extent);
+  }
+  const int margin = 2;
+  const double cols_d = (hi.x() - lo.x()) / cell + 2 * margin + 1;
+  const double rows_d = (hi.y() - lo.y()) / cell + 2 * margin + 1;
+  if (cols_d * rows_d > 2.5e5) return ConvexHull(st);  // too fine: stay cheap
+  cv::Mat1b cells =
+      cv::Mat1b::zeros(static_cast<int>(rows_d), static_cast<int>(cols_d));
+  for (const auto& p : st) {
+    const int c = static_cast<int>((p.x() - lo.x()) / cell) + margin;
+    const int r = static_cast<int>((p.y() - lo.y()) / cell) + margin;
+    cells(r, c) = 255;
+  }
+  cv::morphologyEx(cells, cells, cv::MORPH_CLOSE,
+                   cv::getStructuringElement(cv::MORPH_RECT, {3, 3}));
+  Polygon2d poly = OutlineOfCells(cells, lo, cell, margin);
+  return poly.empty() ? ConvexHull(st) : poly;
+}
+
+// Outline of the union of polygons (one plane's coordinates), with gaps up
+// to `bridge` between them filled: the untextured stretch between two
+// pieces of one wall is wall too. Falls back to the convex hull of all
+// vertices.
+Polygon2d MergedOutline(const std::vector<Polygon2d>& polygons,
+                        double bridge) {
+  std::vector<Eigen::Vector2d> all;
+  for (const Polygon2d& p : polygons) all.insert(all.end(), p.begin(), p.end());
+  Eigen::Vector2d lo = all[0], hi = all[0];
+  for (const auto& v : all) {
+    lo = lo.cwiseMin(v);
+    hi = hi.cwiseMax(v);
+  }
+  // About 400 cells along the longer side, never finer than 1 cm.
+  const double cell = std::max(0.01, (hi - lo).maxCoeff() / 400.0);
+  const int close_r = static_cast<int>(std::ceil(0.5 * bridge / cell)) + 1;
+  const int margin = close_r + 1;
+  const Eigen::Vector2d origin = lo - margin * cell * Eigen::Vector2d::Ones();
+  cv::Mat1b cells = cv::Mat1b::zeros(
+      static_cast<int>((hi.y() - lo.y()) / cell) + 2 * margin + 1,
+      static_cast<int>((hi.x() - lo.x()) / cell) + 2 * margin + 1);
+  constexpr int kShift = 4;  // sub-cell vertex precision for fillPoly
+  for (const Polygon2d& p : polygons) {
+    std::vector<cv::Point> pts;
+    for (const auto& v : p) {
+      // Pixel c covers [c - 0.5, c + 0.5) for fillPoly, [c, c + 1) here.
+      const Eigen::Vector2d c =
+          ((v - origin) / cell - Eigen::Vector2d(0.5, 0.5)) * (1 << kShift);
+      pts.emplace_back(static_cast<int>(std::lround(c.x())),
+                       static_cast<int>(std::lround(c.y())));
+    }
+    cv::fillPoly(cells, std::vector<std::vector<cv::Point>>{pts}, 255,
+                 cv::LINE_8, kShift);
+  }
+  cv::morphologyEx(cells, cells, cv::MORPH_CLOSE,
+                   cv::getStructuringElement(
+                       cv::MORPH_RECT, {2 * close_r + 1, 2 * close_r + 1}));
+  Polygon2d poly = OutlineOfCells(cells, lo, cell, margin);
+  return poly.empty() ? ConvexHull(all) : poly;
 }
 
 // k * standard deviation of a landmark along unit normal n (0 if its
@@ -546,12 +590,10 @@ double PolygonGap(const PlaneSegment& a, const PlaneSegment& b) {
   return gap;
 }
 
-// A segment while merging: its inlier positions, its id as fitted, and the
-// widest gap between merged pieces its polygon must bridge.
+// A segment while merging: its inlier positions and its id as fitted.
 struct MergeItem {
   std::vector<Eigen::Vector3d> pts;
   int fitted_id = 0;
-  double bridge_m = 0.0;
 };
 
 // Whether a and b are one physical plane: normals and offsets agree within
@@ -572,30 +614,35 @@ bool SameSurface(const PlaneFittingOptions& o, const PlaneSegment& a,
   return *gap <= o.merge_max_gap_m;
 }
 
-// Refits seg (plane, frame, in-plane coordinates, polygon) to its points;
-// the polygon bridges gaps up to item.bridge_m.
-void RefitSegment(const FitState& s, const MergeItem& item,
-                  PlaneSegment* seg) {
-  const std::vector<Eigen::Vector3d>& pts = item.pts;
-  seg->plane = FitPlaneLeastSquares(pts);
-  OrientPlane(s.camera_centers, &seg->plane);
-  SetSegmentFrame(pts, seg);
-  seg->inlier_st.resize(pts.size());
-  for (size_t k = 0; k < pts.size(); ++k) {
-    seg->inlier_st[k] = seg->frame.ToPlane(pts[k]);
+// The polygon's vertices in world coordinates.
+std::vector<Eigen::Vector3d> PolygonInWorld(const PlaneSegment& seg) {
+  std::vector<Eigen::Vector3d> out;
+  for (const Eigen::Vector2d& v : seg.polygon) out.push_back(seg.frame.ToWorld(v));
+  return out;
+}
+
+// Refits a (plane, frame, in-plane coordinates) to the points of a and b
+// and bounds it by the union of their polygons, bridging `gap`.
+void MergeInto(const FitState& s, const MergeItem& item,
+               const PlaneSegment& b, double gap, PlaneSegment* a) {
+  const std::vector<std::vector<Eigen::Vector3d>> outlines = {
+      PolygonInWorld(*a), PolygonInWorld(b)};
+  a->inlier_ids.insert(a->inlier_ids.end(), b.inlier_ids.begin(),
+                       b.inlier_ids.end());
+  a->plane = FitPlaneLeastSquares(item.pts);
+  OrientPlane(s.camera_centers, &a->plane);
+  SetSegmentFrame(item.pts, a);
+  a->inlier_st.resize(item.pts.size());
+  for (size_t k = 0; k < item.pts.size(); ++k) {
+    a->inlier_st[k] = a->frame.ToPlane(item.pts[k]);
   }
-  const PlaneFittingOptions& o = s.options;
-  double radius = o.connectivity_radius_m;
-  if (radius <= 0) {
-    radius = std::clamp(
-        o.connectivity_factor * MedianNearestNeighbourSpacing(seg->inlier_st),
-        o.min_connectivity_radius_m, o.max_connectivity_radius_m);
+  std::vector<Polygon2d> polygons(outlines.size());
+  for (size_t i = 0; i < outlines.size(); ++i) {
+    for (const Eigen::Vector3d& x : outlines[i]) {
+      polygons[i].push_back(a->frame.ToPlane(x));
+    }
   }
-  seg->polygon = o.concave_polygon
-                     ? OccupancyOutline(seg->inlier_st,
-                                        o.polygon_cell_factor * radius,
-                                        item.bridge_m)
-                     : ConvexHull(seg->inlier_st);
+  a->polygon = MergedOutline(polygons, gap);
 }
 
 // Merges the first pair of segments that are one surface; false if none.
@@ -613,12 +660,8 @@ bool MergeOnePair(FitState* s, std::vector<MergeItem>* items) {
       m.kept_id = a.fitted_id;
       m.merged_id = b.fitted_id;
       s->report->merges.push_back(m);
-      segs[i].inlier_ids.insert(segs[i].inlier_ids.end(),
-                                segs[j].inlier_ids.begin(),
-                                segs[j].inlier_ids.end());
       a.pts.insert(a.pts.end(), b.pts.begin(), b.pts.end());
-      a.bridge_m = std::max({a.bridge_m, b.bridge_m, gap});
-      RefitSegment(*s, a, &segs[i]);
+      MergeInto(*s, a, segs[j], gap, &segs[i]);
       segs.erase(segs.begin() + j);
       items->erase(items->begin() + j);
       return true;
@@ -637,7 +680,7 @@ void MergeCoplanar(FitState* s) {
   }
   std::vector<MergeItem> items;
   for (const PlaneSegment& seg : segs) {
-    items.push_back({InlierPoints(*s, index, seg), seg.id, 0.0});
+    items.push_back({InlierPoints(*s, index, seg), seg.id});
   }
   while (MergeOnePair(s, &items)) {
   }

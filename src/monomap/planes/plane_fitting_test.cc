@@ -544,6 +544,30 @@ TEST(MergeCoplanar, OneWallFittedAsThreeSegmentsBecomesOnePlane) {
   EXPECT_NEAR(std::abs(PolygonArea(segments[0].polygon)), 3.0, 0.15);
 }
 
+TEST(MergeCoplanar, MergedPolygonCoversTheSparsePieceToo) {
+  // A densely textured stretch beside a sparsely textured one, 10 cm
+  // apart: the merged outline is their union, not the dense part's.
+  std::mt19937_64 rng(6);
+  std::vector<Landmark> lms;
+  AddPatch(0.0, 1.0, 0.0, 1.0, 0.0, 2000, 0.001, 2.0, &rng, &lms);
+  AddPatch(1.1, 2.1, 0.0, 1.0, 0.002, 150, 0.001, 2.0, &rng, &lms);
+  PlaneFittingOptions split;
+  std::vector<PlaneSegment> pieces;
+  FitPlanes(split, &lms, &pieces);
+  ASSERT_EQ(pieces.size(), 2u);
+  const double pieces_area = std::abs(PolygonArea(pieces[0].polygon)) +
+                             std::abs(PolygonArea(pieces[1].polygon));
+  PlaneFittingOptions merge;
+  merge.merge_coplanar = true;
+  std::vector<PlaneSegment> segments;
+  FitPlanes(merge, &lms, &segments);
+  ASSERT_EQ(segments.size(), 1u);
+  // The union plus the bridged 10 cm strip (0.1 m^2), within a few cells.
+  const double area = std::abs(PolygonArea(segments[0].polygon));
+  EXPECT_GT(area, pieces_area);
+  EXPECT_LT(area, pieces_area + 0.15);
+}
+
 TEST(MergeCoplanar, DoorRecessedFiveCentimetresStaysApart) {
   // A wall (z = 0) around a door leaf recessed 5 cm (z = -0.05), seen from 2 m.
   std::mt19937_64 rng(4);
