@@ -27,6 +27,7 @@ struct BuildArgs {
   // Negative flags, applied to `options` after parsing.
   bool no_bundle_adjustment = false;
   bool no_affine = false;
+  bool merge_coplanar = false;  // planes.merge_coplanar + local_ghost_test
   bool quiet = false;
   bool drop_odometry_jumps = false;
   DatasetOptions dataset_options;
@@ -93,8 +94,9 @@ void AddMappingOptions(CLI::App* cmd, BuildArgs* a) {
   cmd->add_option("--ransac-iterations", o.planes.ransac_iterations,
                   "RANSAC hypotheses per plane")
       ->capture_default_str();
-  cmd->add_flag("--merge-coplanar", o.planes.merge_coplanar,
-                "Merge plane segments that are one physical plane");
+  cmd->add_flag("--merge-coplanar", a->merge_coplanar,
+                "Merge plane segments that are one physical plane, and keep "
+                "surfaces beside a plane (a recessed door) apart");
   cmd->add_option("--keyframe-interval", o.keyframes.interval,
                   "Bundle-adjust every n-th frame (1: all frames)")
       ->capture_default_str();
@@ -135,6 +137,8 @@ void RunBuild(const BuildArgs& a) {
   MappingOptions options = a.options;
   options.bundle_adjustment.enabled = !a.no_bundle_adjustment;
   options.tracking.affine_refinement = !a.no_affine;
+  options.planes.merge_coplanar = a.merge_coplanar;
+  options.planes.local_ghost_test = a.merge_coplanar;
   options.show_progress = !a.quiet;
   const MappingResult result = BuildMap(dataset, options);
   WriteMappingResult(a.output, result);

@@ -359,9 +359,8 @@ void RefineHypothesis(const FitState& s, const PlaneEstimator& estimator,
 
 // A "ghost": nearly the same plane as an accepted segment, made of the
 // points just outside that segment's threshold (its noisier points). They
-// are outliers of the real plane, not a second surface. Only the points over
-// the segment's polygon count: a surface beside it, such as a door leaf
-// recessed a few cm in its wall, is a plane of its own.
+// are outliers of the real plane, not a second surface. With
+// local_ghost_test only the points over the segment's polygon count.
 bool IsGhost(const FitState& s, const Plane& plane,
              const std::vector<size_t>& inliers) {
   for (const PlaneSegment& seg : *s.segments) {
@@ -371,7 +370,10 @@ bool IsGhost(const FitState& s, const Plane& plane,
     double dist = 0.0, thr = 0.0;
     size_t over = 0;
     for (size_t k : inliers) {
-      if (!PointInPolygon(seg.polygon, seg.frame.ToPlane(s.pts[k]))) continue;
+      if (s.options.local_ghost_test &&
+          !PointInPolygon(seg.polygon, seg.frame.ToPlane(s.pts[k]))) {
+        continue;
+      }
       ++over;
       dist += std::abs(seg.plane.SignedDistance(s.pts[k]));
       thr += 1.0 / s.inv_thr[k];

@@ -551,13 +551,16 @@ TEST(MergeCoplanar, MergedPolygonCoversTheSparsePieceToo) {
   std::vector<Landmark> lms;
   AddPatch(0.0, 1.0, 0.0, 1.0, 0.0, 2000, 0.001, 2.0, &rng, &lms);
   AddPatch(1.1, 2.1, 0.0, 1.0, 0.002, 150, 0.001, 2.0, &rng, &lms);
+  // Without the local ghost test the sparse piece, beside the dense one and
+  // in its plane, would be rejected as its ghost.
   PlaneFittingOptions split;
+  split.local_ghost_test = true;
   std::vector<PlaneSegment> pieces;
   FitPlanes(split, &lms, &pieces);
   ASSERT_EQ(pieces.size(), 2u);
   const double pieces_area = std::abs(PolygonArea(pieces[0].polygon)) +
                              std::abs(PolygonArea(pieces[1].polygon));
-  PlaneFittingOptions merge;
+  PlaneFittingOptions merge = split;
   merge.merge_coplanar = true;
   std::vector<PlaneSegment> segments;
   FitPlanes(merge, &lms, &segments);
@@ -577,6 +580,7 @@ TEST(MergeCoplanar, DoorRecessedFiveCentimetresStaysApart) {
   AddPatch(1.0, 1.9, 0.0, 2.0, -0.05, 700, 0.002, 2.0, &rng, &lms);
   PlaneFittingOptions merge;
   merge.merge_coplanar = true;
+  merge.local_ghost_test = true;
   std::vector<PlaneSegment> segments;
   const auto report = FitPlanes(merge, &lms, &segments);
   // The two wall stretches merge (the door between them is 0.9 m wide, over
