@@ -36,6 +36,10 @@ def sim_row(out, case):
         "points": rel["count"],
         "median_error_percent": rel["median"],
         "p90_error_percent": rel["p90"],
+        "area_recall": e["area"]["area_recall"],
+        "seen_area_m2": e["area"]["seen_area_m2"],
+        "large_planes_seen": e["area"]["large_planes_seen"],
+        "large_planes_recovered": e["area"]["large_planes_recovered"],
     }
 
 
@@ -68,20 +72,22 @@ def main():
     with open(os.path.join(out, "generalization.json"), "w") as f:
         json.dump({"simulated": sims, "real": reals}, f, indent=1)
     lines = ["| run | h m / pitch deg / fps | build s | map planes | true planes seen / recovered / split"
-             " | precision | points | median error % of distance (p90) |",
-             "|---|---|---|---|---|---|---|---|"]
+             " | precision | area recovered (of m^2 seen) | planes >= 1 m^2 recovered"
+             " | points | median error % of distance (p90) |",
+             "|---|---|---|---|---|---|---|---|---|---|"]
     for r in sims:
         lines.append(
             f"| {r['name'].split('_')[0]} seed {r['seed']} | {r['camera_height_m']:g} / {r['pitch_deg']:g} /"
             f" {r['fps']:g} | {r['build_s']} | {r['fitted_planes']} | {r['observed_true_planes']} /"
             f" {r['recovered_true_planes']} / {r['split_true_planes']} | {r['precision']:.2f} |"
-            f" {r['points']} | {r['median_error_percent']:.2f} ({r['p90_error_percent']:.2f}) |")
+            f" {100 * r['area_recall']:.0f} % ({r['seen_area_m2']:.0f}) |"
+            f" {r['large_planes_recovered']} / {r['large_planes_seen']} | {r['points']} | {r['median_error_percent']:.2f} ({r['p90_error_percent']:.2f}) |")
     for r in reals:
         rel = find_stat(r["eval_points"], "relative") or {}
         ab = find_stat(r["eval_points"], "abs") or {}
         med_mm = ab.get("median", float("nan")) * 1000
         lines.append(
-            f"| {r['name']} | real | {r['build_s']} | - | - | - | {rel.get('count', '-')} |"
+            f"| {r['name']} | real | {r['build_s']} | - | - | - | - | - | {rel.get('count', '-')} |"
             f" {rel.get('median', float('nan')):.2f} ({rel.get('p90', float('nan')):.2f}); {med_mm:.2f} mm |")
     with open(os.path.join(out, "generalization.md"), "w") as f:
         f.write("\n".join(lines) + "\n")
