@@ -164,8 +164,9 @@ MappingResult BuildMap(const Dataset& dataset, const MappingOptions& options) {
     throw StageError("need at least 2 frames to build a map, got " +
                      std::to_string(num_frames));
   }
-  // The dataset's calibration; bundle adjustment may refine its distortion,
-  // and every stage after it (and the map) uses the refined lens.
+  // The dataset's calibration; bundle adjustment may refine it (distortion,
+  // or the intrinsics), and every stage after it (and the map) uses the
+  // refined lens.
   Camera camera = dataset.camera;
   camera.Check();
 
@@ -239,7 +240,7 @@ MappingResult BuildMap(const Dataset& dataset, const MappingOptions& options) {
     report.bundle_adjustment =
         BundleAdjustKeyframes(camera, *tracks, ba, options.keyframe_interval,
                               &world_from_cam, &landmarks);
-    camera.distortion = report.bundle_adjustment.distortion;
+    camera = report.bundle_adjustment.camera;
     report.timings.push_back({"bundle_adjustment", timer.ElapsedSeconds()});
     timer.Restart();
     report.retriangulation = TriangulateTracks(
@@ -292,6 +293,33 @@ MappingResult BuildMap(const Dataset& dataset, const MappingOptions& options) {
   return result;
 }
 
+namespace {
+
+nlohmann::json LensJson(const std::array<double, kLensSize>& v) {
+  return {{"fx", v[kLensFx]}, {"fy", v[kLensFy]}, {"cx", v[kLensCx]},
+          {"cy", v[kLensCy]}, {"k1", v[kLensK1]}, {"k2", v[kLensK2]}};
+}
+
+// Lens self-calibration: refined or not and why, before and after, prior
+// and marginal standard deviations.
+nlohmann::json IntrinsicsJson(const IntrinsicsRefinementReport& r) {
+  if (!r.attempted) return {{"attempted", false}};
+  return {{"attempted", true},
+          {"refined", r.refined()},
+          {"focal_refined", r.group_refined[kGroupFocal]},
+          {"principal_point_refined", r.group_refined[kGroupPrincipalPoint]},
+          {"radial_refined", r.group_refined[kGroupRadial]},
+          {"reason", r.reason},
+          {"before", LensJson(LensParameters(r.before))},
+          {"after", LensJson(LensParameters(r.after))},
+          {"candidate", LensJson(r.candidate)},
+          {"prior_std", LensJson(r.prior_std)},
+          {"posterior_std", LensJson(r.posterior_std)},
+          {"covariance_seconds", r.covariance_seconds}};
+}
+
+}  // namespace
+
 nlohmann::json MappingReport::ToJson() const {
   nlohmann::json j;
   j["num_frames"] = num_frames;
@@ -339,7 +367,8 @@ nlohmann::json MappingReport::ToJson() const {
       {"linear_solver", bundle_adjustment.linear_solver},
       {"points_dropped", bundle_adjustment.num_dropped},
       {"mean_pose_change_m", bundle_adjustment.mean_pose_change_m},
-      {"mean_pose_change_deg", bundle_adjustment.mean_pose_change_deg}};
+      {"mean_pose_change_deg", bundle_adjustment.mean_pose_change_deg},
+      {"intrinsics", IntrinsicsJson(bundle_adjustment.intrinsics)}};
   nlohmann::json planes_json = {
       {"planes", planes.num_planes},
       {"outliers", planes.num_outliers},
