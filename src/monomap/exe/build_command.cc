@@ -82,15 +82,14 @@ void AddBundleAdjustmentOptions(CLI::App* cmd, BundleAdjustmentOptions* o) {
                 "Bundle adjustment refines the lens distortion coefficients");
   IntrinsicsRefinementOptions& lens = o->intrinsics;
   cmd->add_flag("--refine-intrinsics", lens.enabled,
-                "Lens self-calibration: bundle adjustment refines focal "
-                "length, principal point and k1, k2 under a prior at the "
-                "given calibration, where the data constrain them (the "
-                "report says which and why)");
-  cmd->add_flag("--lens-fix-focal{false}", lens.refine_focal,
-                "With --refine-intrinsics: keep the given focal length");
-  cmd->add_flag("--lens-fix-principal-point{false}",
-                lens.refine_principal_point,
-                "With --refine-intrinsics: keep the given principal point");
+                "Lens self-calibration: bundle adjustment refines k1, k2 "
+                "(and with the flags below focal length, principal point) "
+                "under a prior at the given calibration, where the data "
+                "constrain them (the report says which and why)");
+  cmd->add_flag("--lens-refine-focal", lens.refine_focal,
+                "With --refine-intrinsics: also try the focal length");
+  cmd->add_flag("--lens-refine-principal-point", lens.refine_principal_point,
+                "With --refine-intrinsics: also try the principal point");
   cmd->add_flag("--lens-fix-radial{false}", lens.refine_radial,
                 "With --refine-intrinsics: keep the given k1, k2");
   cmd->add_option("--lens-focal-sigma", lens.focal_sigma_fraction,

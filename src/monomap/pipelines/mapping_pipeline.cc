@@ -153,6 +153,12 @@ BundleAdjustmentReport BundleAdjustKeyframes(
 
 }  // namespace
 
+bool SameCalibration(const Camera& a, const Camera& b) {
+  return a.width == b.width && a.height == b.height && a.fx == b.fx &&
+         a.fy == b.fy && a.cx == b.cx && a.cy == b.cy &&
+         a.distortion == b.distortion;
+}
+
 MappingResult BuildMap(const Dataset& dataset, const MappingOptions& options) {
   options.Check();
   Timer total;
@@ -260,6 +266,9 @@ MappingResult BuildMap(const Dataset& dataset, const MappingOptions& options) {
   }
 
   result.map.camera = camera;
+  if (!SameCalibration(camera, dataset.camera)) {
+    result.map.given_camera = dataset.camera;
+  }
   result.map.trajectory.reserve(num_frames);
   for (int i = 0; i < num_frames; ++i) {
     result.map.trajectory.push_back(
