@@ -202,8 +202,8 @@ TexturedPlane ReadPlane(const JsonFields& f, const json& p,
   for (const auto& a : axes) {
     const std::string axis_field = JsonFields::Join(field, a.key);
     if (std::abs(a.axis.norm() - 1.0) > kMapUnitTolerance) {
-      f.Fail(axis_field, "not of unit length (norm " +
-                             std::to_string(a.axis.norm()) + ")");
+      f.Fail(axis_field,
+             "not of unit length (norm " + std::to_string(a.axis.norm()) + ")");
     }
     if (std::abs(a.axis.dot(n)) > kMapUnitTolerance) {
       f.Fail(axis_field, "not in the plane (dot with normal " +
@@ -229,8 +229,8 @@ TexturedPlane ReadPlane(const JsonFields& f, const json& p,
   const std::string polygon_field = JsonFields::Join(field, "polygon");
   const json& polygon = f.Array(p, field, "polygon");
   if (polygon.size() < 3) {
-    f.Fail(polygon_field, "needs at least 3 vertices, got " +
-                              std::to_string(polygon.size()));
+    f.Fail(polygon_field,
+           "needs at least 3 vertices, got " + std::to_string(polygon.size()));
   }
   for (size_t i = 0; i < polygon.size(); ++i) {
     plane.polygon.push_back(
@@ -256,8 +256,8 @@ TexturedPlane ReadPlane(const JsonFields& f, const json& p,
   if (texture_name.empty() || texture_path.has_parent_path() ||
       texture_path.is_absolute() || texture_name == "." ||
       texture_name == "..") {
-    f.Fail(texture_field, "'" + texture_name +
-                              "' is not a plain file name in the map folder");
+    f.Fail(texture_field,
+           "'" + texture_name + "' is not a plain file name in the map folder");
   }
   const fs::path full = dir / texture_path;
   std::error_code ec;
@@ -283,9 +283,12 @@ std::string FormatMapJson(const Map& map) {
   root["format"] = kMapFormatName;
   root["version"] = kMapFormatVersion;
   auto camera_json = [](const Camera& c) {
-    return OrderedJson{{"width", c.width},   {"height", c.height},
-                       {"fx", c.fx},         {"fy", c.fy},
-                       {"cx", c.cx},         {"cy", c.cy},
+    return OrderedJson{{"width", c.width},
+                       {"height", c.height},
+                       {"fx", c.fx},
+                       {"fy", c.fy},
+                       {"cx", c.cx},
+                       {"cy", c.cy},
                        {"distortion", c.distortion}};
   };
   root["camera"] = camera_json(map.camera);

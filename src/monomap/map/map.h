@@ -3,13 +3,12 @@
 // these types and talk to each other only through them.
 #pragma once
 
+#include <Eigen/Core>
 #include <cstdint>
+#include <opencv2/core.hpp>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
-#include <opencv2/core.hpp>
 
 #include "monomap/camera/camera.h"
 #include "monomap/geometry/plane.h"

@@ -106,8 +106,7 @@ void AddErrors(const Dataset& dataset, const std::vector<TimedPose>& estimate,
 
 }  // namespace
 
-Camera LensForLocalization(const Map& map, const Camera& live,
-                           bool* from_map) {
+Camera LensForLocalization(const Map& map, const Camera& live, bool* from_map) {
   const bool use_map =
       map.given_camera && SameCalibration(*map.given_camera, live);
   if (from_map) *from_map = use_map;
@@ -164,8 +163,8 @@ std::unique_ptr<LocalizationSession> OpenLocalizationSession(
   auto map = std::make_shared<const Map>(ReadMap(map_dir));
   const Camera camera =
       live_camera ? LensForLocalization(*map, *live_camera) : map->camera;
-  return std::make_unique<LocalizationSession>(std::move(map), camera,
-                                               options, base_from_cam);
+  return std::make_unique<LocalizationSession>(std::move(map), camera, options,
+                                               base_from_cam);
 }
 
 }  // namespace monomap

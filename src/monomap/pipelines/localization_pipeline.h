@@ -78,7 +78,8 @@ Camera LensForLocalization(const Map& map, const Camera& live,
 
 // A streaming session over the map in `map_dir` (io/map_format.h), for a
 // live robot. `live_camera`: the camera the images come from (its refined
-// lens if the map holds one, LensForLocalization); empty: the map's camera. Throws InputError if the map does not load.
+// lens if the map holds one, LensForLocalization); empty: the map's camera.
+// Throws InputError if the map does not load.
 std::unique_ptr<LocalizationSession> OpenLocalizationSession(
     const std::filesystem::path& map_dir, const SessionOptions& options,
     const std::optional<Camera>& live_camera = {},

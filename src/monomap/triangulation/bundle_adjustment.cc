@@ -3,12 +3,11 @@
 #include <ceres/ceres.h>
 #include <ceres/manifold.h>
 #include <ceres/product_manifold.h>
-
-#include <Eigen/SparseCholesky>
-#include <Eigen/SparseCore>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
 #include <algorithm>
 #include <cmath>
 #include <iostream>
@@ -114,8 +113,7 @@ struct ReprojectionCost {
 // k2) as a parameter (intrinsics_refinement.h).
 struct LensReprojectionCost {
   template <typename T>
-  bool operator()(const T* pose, const T* x, const T* lens,
-                  T* residual) const {
+  bool operator()(const T* pose, const T* x, const T* lens, T* residual) const {
     Eigen::Matrix<T, 3, 1> x_in_cam;
     if (!ReprojectionCost::ToCamera(pose, x, &x_in_cam)) return false;
     T px[2];
@@ -328,9 +326,8 @@ class BundleAdjuster {
   // Prior and manifold (fixed groups constant) of the lens block.
   void ParameterizeLens();
   internal::LensConstants LensConstantsOf() const {
-    return {camera_.distortion[2], camera_.distortion[3],
-            camera_.distortion[4], options_.intrinsics.shared_focal,
-            camera_.fy / camera_.fx};
+    return {camera_.distortion[2], camera_.distortion[3], camera_.distortion[4],
+            options_.intrinsics.shared_focal, camera_.fy / camera_.fx};
   }
   void AddLandmarkToProblem(size_t i);
   // Odometry prior on the relative pose of poses i and j.
@@ -769,7 +766,8 @@ namespace {
 // candidate values and the judgement of each group, into *lens.
 void JudgeTrialLens(const Camera& camera,
                     const BundleAdjustmentOptions& options,
-                    BundleAdjuster* adjuster, IntrinsicsRefinementReport* lens) {
+                    BundleAdjuster* adjuster,
+                    IntrinsicsRefinementReport* lens) {
   const Timer timer;
   const bool ok = adjuster->LensStandardDeviations(&lens->posterior_std);
   if (!ok) lens->posterior_std.fill(-1.0);
@@ -849,10 +847,10 @@ BundleAdjustmentReport BundleAdjust(const Camera& camera,
     // Trial with the chosen groups free under their prior; kept if every
     // group passes the judgement, else adjusted again without the others.
     lens.attempted = true;
-    done = AdjustOnce(camera, tracks, options,
-                      {io.refine_focal, io.refine_principal_point,
-                       io.refine_radial},
-                      &lens, world_from_cam, landmarks, &report);
+    done = AdjustOnce(
+        camera, tracks, options,
+        {io.refine_focal, io.refine_principal_point, io.refine_radial}, &lens,
+        world_from_cam, landmarks, &report);
   }
   if (!done) {
     AdjustOnce(camera, tracks, options, lens.group_refined, nullptr,

@@ -18,16 +18,21 @@ void IntrinsicsRefinementOptions::Check() const {
   CheckOption(k2_sigma > 0, "intrinsics.k2_sigma", "must be positive");
   CheckOption(max_posterior_to_prior_std > 0 && max_posterior_to_prior_std <= 1,
               "intrinsics.max_posterior_to_prior_std", "must be in (0, 1]");
-  CheckOption(!enabled || refine_focal || refine_principal_point ||
-                  refine_radial,
-              "intrinsics.refine_focal", "enabled needs at least one group "
-              "(focal, principal point, radial) to refine");
+  CheckOption(
+      !enabled || refine_focal || refine_principal_point || refine_radial,
+      "intrinsics.refine_focal",
+      "enabled needs at least one group "
+      "(focal, principal point, radial) to refine");
   CheckOption(max_change_prior_sigmas > 0, "intrinsics.max_change_prior_sigmas",
               "must be positive");
 }
 
 std::array<double, kLensSize> LensParameters(const Camera& camera) {
-  return {camera.fx, camera.fy, camera.cx, camera.cy, camera.distortion[0],
+  return {camera.fx,
+          camera.fy,
+          camera.cx,
+          camera.cy,
+          camera.distortion[0],
           camera.distortion[1]};
 }
 
@@ -93,14 +98,16 @@ void JudgeLensGroups(const IntrinsicsRefinementOptions& options,
     for (int k : GroupParameters(static_cast<LensGroup>(g), shared)) {
       const double prior = report->prior_std[k];
       ratio = std::max(ratio, report->posterior_std[k] / prior);
-      change = std::max(
-          change, std::abs(report->candidate[k] - given[k]) / prior);
+      change =
+          std::max(change, std::abs(report->candidate[k] - given[k]) / prior);
     }
     char sentence[200];
     if (!wanted[g]) {
       report->group_refined[g] = false;
-      std::snprintf(sentence, sizeof(sentence), "%s kept: not refined by "
-                    "option. ", GroupName(g));
+      std::snprintf(sentence, sizeof(sentence),
+                    "%s kept: not refined by "
+                    "option. ",
+                    GroupName(g));
     } else if (!posterior_ok) {
       report->group_refined[g] = false;
       std::snprintf(sentence, sizeof(sentence),
