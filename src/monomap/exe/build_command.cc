@@ -80,7 +80,13 @@ void AddBundleAdjustmentOptions(CLI::App* cmd, BundleAdjustmentOptions* o) {
       ->capture_default_str();
   cmd->add_flag("--refine-distortion", o->refine_distortion,
                 "Bundle adjustment refines the lens distortion coefficients");
-  IntrinsicsRefinementOptions& lens = o->intrinsics;
+  cmd->add_flag("--ba-verbose", o->verbose,
+                "Print the bundle adjustment solver's progress and report");
+}
+
+// Lens self-calibration (intrinsics_refinement.h).
+void AddLensOptions(CLI::App* cmd, IntrinsicsRefinementOptions* o) {
+  IntrinsicsRefinementOptions& lens = *o;
   cmd->add_flag("--refine-intrinsics", lens.enabled,
                 "Lens self-calibration: bundle adjustment refines k1, k2 "
                 "(and with the flags below focal length, principal point) "
@@ -107,8 +113,6 @@ void AddBundleAdjustmentOptions(CLI::App* cmd, BundleAdjustmentOptions* o) {
   cmd->add_option("--lens-k2-sigma", lens.k2_sigma, "Prior sigma of k2")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  cmd->add_flag("--ba-verbose", o->verbose,
-                "Print the bundle adjustment solver's progress and report");
 }
 
 void AddMappingOptions(CLI::App* cmd, BuildArgs* a) {
@@ -134,6 +138,7 @@ void AddMappingOptions(CLI::App* cmd, BuildArgs* a) {
                 "Track frame to frame only (no alignment with each "
                 "feature's reference patch)");
   AddBundleAdjustmentOptions(cmd, &o.bundle_adjustment);
+  AddLensOptions(cmd, &o.bundle_adjustment.intrinsics);
 }
 
 void RunBuild(const BuildArgs& a) {
