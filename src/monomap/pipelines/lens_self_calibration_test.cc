@@ -2,6 +2,12 @@
 // traversal localized (demo pipeline) with the true lens, with a perturbed
 // calibration (fx, fy +1 %, k1 x 0.85) as given, and with that perturbed
 // calibration under lens self-calibration (build --refine-intrinsics).
+// Measured (eecb514, seed 1, 200 frames, MCC over 60 frames from a global
+// start): median error over all exported points 0.649 % (true lens), 1.661 %
+// (wrong, 2 of 3 planes), 0.543 % (refined: k1 -0.2545 for a true -0.25);
+// MCC mean error 13.9 mm / 0.031 deg, 14.3 mm / 0.314 deg, 15.0 mm /
+// 0.051 deg. Points and translation are within the 10 %; rotation
+// is not (fx stays 1 % off): the test asks a factor 2.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -23,6 +29,7 @@ struct LensRun {
   double mcc_mean_rotation_deg = 0.0;
   double mcc_fraction_within = 0.0;
   DemoReport report;
+  Map map;  // as written to map.json
 };
 
 LensRun RunWithLens(const std::string& name, const std::optional<Camera>& given,
@@ -39,6 +46,7 @@ LensRun RunWithLens(const std::string& name, const std::optional<Camera>& given,
   o.localization.particles = 1500;
   LensRun run;
   run.report = RunDemo(o);
+  run.map = ReadMap(run.report.map_dir);
   const StructureAccuracy& s = run.report.structure;
   run.point_median_percent = s.point_error_all.relative_percent.median;
   for (const TruePlaneResult& t : s.true_plane_results) {
@@ -79,7 +87,7 @@ TEST(LensSelfCalibrationTest, PerturbedLensMapsAndLocalizesAsTheTrueLens) {
   EXPECT_TRUE(lens["radial_refined"].get<bool>());
   EXPECT_NEAR(lens["after"]["k1"].get<double>(), true_lens.distortion[0], 0.01);
   // The map holds the refined lens and the calibration it was given.
-  const Map map = ReadMap(refined.report.map_dir);
+  const Map& map = refined.map;
   ASSERT_TRUE(map.given_camera.has_value());
   EXPECT_EQ(map.given_camera->distortion, perturbed.distortion);
   EXPECT_NE(map.camera.distortion, perturbed.distortion);
@@ -90,12 +98,16 @@ TEST(LensSelfCalibrationTest, PerturbedLensMapsAndLocalizesAsTheTrueLens) {
   // ... and self-calibration brings map and localization back to the true
   // lens' accuracy.
   EXPECT_EQ(refined.planes_matched, truth.planes_matched);
+  EXPECT_FALSE(truth.map.given_camera.has_value());
   EXPECT_LT(refined.point_median_percent, 1.1 * truth.point_median_percent);
   EXPECT_GE(refined.mcc_fraction_within, truth.mcc_fraction_within - 0.05);
   EXPECT_LT(refined.mcc_mean_translation_m,
             1.1 * truth.mcc_mean_translation_m + 0.002);
-  EXPECT_LT(refined.mcc_mean_rotation_deg,
-            1.1 * truth.mcc_mean_rotation_deg + 0.05);
+  // Rotation: the wrong lens costs a factor ~10; the refined one keeps
+  // fx 1 % off (focal length is not refined by default) and stays within a
+  // factor 2 of the true lens (0.051 vs 0.031 deg).
+  EXPECT_LT(refined.mcc_mean_rotation_deg, 2.0 * truth.mcc_mean_rotation_deg);
+  EXPECT_LT(refined.mcc_mean_rotation_deg, 0.25 * wrong.mcc_mean_rotation_deg);
 }
 
 }  // namespace
