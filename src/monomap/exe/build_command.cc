@@ -85,6 +85,37 @@ void AddBundleAdjustmentOptions(CLI::App* cmd, BundleAdjustmentOptions* o) {
                 "Print the bundle adjustment solver's progress and report");
 }
 
+// Lens self-calibration (intrinsics_refinement.h).
+void AddLensOptions(CLI::App* cmd, IntrinsicsRefinementOptions* o) {
+  IntrinsicsRefinementOptions& lens = *o;
+  cmd->add_flag("--refine-intrinsics", lens.enabled,
+                "Lens self-calibration: bundle adjustment refines k1, k2 "
+                "(and with the flags below focal length, principal point) "
+                "under a prior at the given calibration, where the data "
+                "constrain them (the report says which and why)");
+  cmd->add_flag("--lens-refine-focal", lens.refine_focal,
+                "With --refine-intrinsics: also try the focal length");
+  cmd->add_flag("--lens-refine-principal-point", lens.refine_principal_point,
+                "With --refine-intrinsics: also try the principal point");
+  cmd->add_flag("--lens-fix-radial{false}", lens.refine_radial,
+                "With --refine-intrinsics: keep the given k1, k2");
+  cmd->add_option("--lens-focal-sigma", lens.focal_sigma_fraction,
+                  "Prior sigma of the focal length (fraction of fx)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd->add_option("--lens-principal-point-sigma",
+                  lens.principal_point_sigma_fraction,
+                  "Prior sigma of the principal point (fraction of width)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd->add_option("--lens-k1-sigma", lens.k1_sigma, "Prior sigma of k1")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd->add_option("--lens-k2-sigma", lens.k2_sigma, "Prior sigma of k2")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+}
+
 void AddMappingOptions(CLI::App* cmd, BuildArgs* a) {
   MappingOptions& o = a->options;
   cmd->add_flag("--no-ba", a->no_bundle_adjustment,
@@ -111,6 +142,7 @@ void AddMappingOptions(CLI::App* cmd, BuildArgs* a) {
                 "Track frame to frame only (no alignment with each "
                 "feature's reference patch)");
   AddBundleAdjustmentOptions(cmd, &o.bundle_adjustment);
+  AddLensOptions(cmd, &o.bundle_adjustment.intrinsics);
 }
 
 void RunBuild(const BuildArgs& a) {

@@ -150,39 +150,41 @@ class JsonFields {
   std::string file_;
 };
 
-Camera ReadCamera(const JsonFields& f, const json& root) {
-  const json& c = f.Get(root, "", "camera");
-  if (!c.is_object()) f.Fail("camera", "expected an object");
+// The camera object under `key` ("camera", or "given_camera").
+Camera ReadCamera(const JsonFields& f, const json& root,
+                  const std::string& key) {
+  const json& c = f.Get(root, "", key);
+  if (!c.is_object()) f.Fail(key, "expected an object");
   Camera camera;
-  camera.width = f.Int(c, "camera", "width");
-  camera.height = f.Int(c, "camera", "height");
-  camera.fx = f.Number(c, "camera", "fx");
-  camera.fy = f.Number(c, "camera", "fy");
-  camera.cx = f.Number(c, "camera", "cx");
-  camera.cy = f.Number(c, "camera", "cy");
-  const auto d = f.Vector<5>(c, "camera", "distortion");
+  camera.width = f.Int(c, key, "width");
+  camera.height = f.Int(c, key, "height");
+  camera.fx = f.Number(c, key, "fx");
+  camera.fy = f.Number(c, key, "fy");
+  camera.cx = f.Number(c, key, "cx");
+  camera.cy = f.Number(c, key, "cy");
+  const auto d = f.Vector<5>(c, key, "distortion");
   for (int i = 0; i < 5; ++i) camera.distortion[i] = d[i];
   // "model" is written only for lenses other than plumb_bob, so maps of a
   // plumb_bob camera read and write as before.
   if (c.contains("model")) {
-    const std::string name = f.String(c, "camera", "model");
+    const std::string name = f.String(c, key, "model");
     const auto model = LensModelFromName(name);
     if (!model) {
-      f.Fail("camera.model",
+      f.Fail(key + ".model",
              "'" + name + "' is not supported (plumb_bob or equidistant)");
     }
     camera.model = *model;
   }
   if (camera.width <= 0 || camera.height <= 0) {
-    f.Fail(camera.width <= 0 ? "camera.width" : "camera.height",
+    f.Fail(key + (camera.width <= 0 ? ".width" : ".height"),
            "must be positive");
   }
   // Checked before anything allocates an image of the camera's size.
   const std::string size_error =
       ImageSizeLimitError(camera.width, camera.height);
-  if (!size_error.empty()) f.Fail("camera", size_error);
-  if (camera.fx <= 0) f.Fail("camera.fx", "must be positive");
-  if (camera.fy <= 0) f.Fail("camera.fy", "must be positive");
+  if (!size_error.empty()) f.Fail(key, size_error);
+  if (camera.fx <= 0) f.Fail(key + ".fx", "must be positive");
+  if (camera.fy <= 0) f.Fail(key + ".fy", "must be positive");
   return camera;
 }
 
@@ -314,14 +316,19 @@ std::string FormatMapJson(const Map& map) {
   OrderedJson root;
   root["format"] = kMapFormatName;
   root["version"] = kMapFormatVersion;
-  const Camera& c = map.camera;
-  root["camera"] = {{"width", c.width},   {"height", c.height},
-                    {"fx", c.fx},         {"fy", c.fy},
-                    {"cx", c.cx},         {"cy", c.cy},
-                    {"distortion", c.distortion}};
-  if (c.model != LensModel::kPlumbBob) {
-    root["camera"]["model"] = LensModelName(c.model);
-  }
+  auto camera_json = [](const Camera& c) {
+    OrderedJson j{{"width", c.width},
+                  {"height", c.height},
+                  {"fx", c.fx},
+                  {"fy", c.fy},
+                  {"cx", c.cx},
+                  {"cy", c.cy},
+                  {"distortion", c.distortion}};
+    if (c.model != LensModel::kPlumbBob) j["model"] = LensModelName(c.model);
+    return j;
+  };
+  root["camera"] = camera_json(map.camera);
+  if (map.given_camera) root["given_camera"] = camera_json(*map.given_camera);
   OrderedJson planes = OrderedJson::array();
   for (const TexturedPlane& p : map.planes) {
     OrderedJson polygon = OrderedJson::array();
@@ -417,7 +424,10 @@ Map ReadMap(const fs::path& dir) {
                           std::to_string(kMapFormatVersion) + ")");
   }
   Map map;
-  map.camera = ReadCamera(f, root);
+  map.camera = ReadCamera(f, root, "camera");
+  if (root.contains("given_camera")) {
+    map.given_camera = ReadCamera(f, root, "given_camera");
+  }
   const json& planes = f.Array(root, "", "planes");
   std::set<int> ids;
   for (size_t i = 0; i < planes.size(); ++i) {

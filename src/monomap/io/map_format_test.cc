@@ -214,6 +214,24 @@ TEST(MapFormatTest, EquidistantLensRoundTrips) {
   }
 }
 
+// A map whose lens bundle adjustment refined keeps the calibration it was
+// built from (given_camera, with its lens model); maps without one do not
+// write the field.
+TEST(MapFormatTest, GivenCameraRoundTrips) {
+  EXPECT_FALSE(LoadJson(WriteTestMap("no_given")).contains("given_camera"));
+  Map map = MakeTestMap();
+  map.camera.model = LensModel::kEquidistant;
+  map.given_camera = map.camera;
+  map.given_camera->fx *= 1.01;
+  map.given_camera->distortion[0] = 0.05;
+  const Map read = ReadMap(WriteTestMap("given", map));
+  ASSERT_TRUE(read.given_camera.has_value());
+  EXPECT_EQ(read.given_camera->model, LensModel::kEquidistant);
+  EXPECT_EQ(read.given_camera->fx, map.given_camera->fx);
+  EXPECT_EQ(read.given_camera->distortion, map.given_camera->distortion);
+  EXPECT_EQ(read.camera.fx, map.camera.fx);
+}
+
 TEST(MapFormatTest, WriteRejectsUnwritableMaps) {
   Map map = MakeTestMap();
   map.planes[1].texture = cv::Mat();
@@ -302,6 +320,18 @@ TEST(MapFormatTest, InvalidFieldsAreNamed) {
        {"field 'camera.model'", "'fov' is not supported"}},
       {"distortion", [](json& j) { j["camera"]["distortion"] = {0.1}; },
        {"field 'camera.distortion'", "expected 5"}},
+      {"given_camera",
+       [](json& j) {
+         j["given_camera"] = j["camera"];
+         j["given_camera"]["model"] = "fov";
+       },
+       {"field 'given_camera.model'", "'fov' is not supported"}},
+      {"given_camera_fy",
+       [](json& j) {
+         j["given_camera"] = j["camera"];
+         j["given_camera"]["fy"] = 0;
+       },
+       {"field 'given_camera.fy'", "positive"}},
       {"no_planes", [](json& j) { j.erase("planes"); },
        {"field 'planes': missing"}},
       {"num_frames", [](json& j) { j["num_frames"] = 5; },

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -105,7 +106,11 @@ struct TexturedPlane {
 
 // The whole map: what `monomap build` writes and `render`/`localize` read.
 struct Map {
+  // The lens the map's geometry goes with (refined by bundle adjustment's
+  // self-calibration, if it was on and the data constrained the lens).
   Camera camera;
+  // The calibration the map was built from, when `camera` differs from it.
+  std::optional<Camera> given_camera;
   std::vector<TexturedPlane> planes;
   std::vector<Landmark> landmarks;
   std::vector<TimedPose> trajectory;  // refined world_from_cam per frame

@@ -25,6 +25,12 @@ void DemoOptions::Check() const {
   CheckOption(width >= 64 && height >= 48, "width/height",
               "must be at least 64x48");
   structure.Check();
+  mapping.Check();
+  if (given_camera) {
+    CheckOption(given_camera->width == width && given_camera->height == height,
+                "given_camera", "must have the simulated image size");
+    given_camera->Check();
+  }
   CheckOption(rpe_delta_frames >= 1, "rpe_delta_frames", "must be at least 1");
   if (localization.enabled) localization.Check();
 }
@@ -135,10 +141,11 @@ DemoReport RunDemo(const DemoOptions& options) {
   sim.height = options.height;
   sim.show_progress = options.show_progress;
   report.simulate_seconds = Simulate(sim, report.dataset_dir).seconds;
-  const DemoDataset data = LoadDemoDataset(report.dataset_dir);
+  DemoDataset data = LoadDemoDataset(report.dataset_dir);
+  if (options.given_camera) data.blind.camera = *options.given_camera;
 
   say("building the map -> " + report.map_dir.string());
-  MappingOptions mapping_options;
+  MappingOptions mapping_options = options.mapping;
   mapping_options.show_progress = options.show_progress;
   const Timer mapping_timer;
   const MappingResult result = BuildMap(data.blind, mapping_options);
@@ -157,9 +164,11 @@ DemoReport RunDemo(const DemoOptions& options) {
 
   if (options.localization.enabled) {
     say("localizing a second traversal (MCL and MCC, global start)");
+    DemoLocalizationOptions localization = options.localization;
+    localization.given_camera = options.given_camera;
     report.localization =
         RunDemoLocalization(result.map, sim, world_from_map.Inverse(),
-                            options.localization, dir / "localization_dataset");
+                            localization, dir / "localization_dataset");
   }
   report.total_seconds = total_timer.ElapsedSeconds();
   WriteFileAtomic(report.report_json, report.ToJson().dump(2) + "\n");

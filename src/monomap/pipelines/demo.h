@@ -14,12 +14,14 @@
 #include <cstdint>
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "monomap/eval/structure_accuracy.h"
 #include "monomap/eval/trajectory_metrics.h"
 #include "monomap/pipelines/demo_localization.h"
+#include "monomap/pipelines/mapping_pipeline.h"
 
 namespace monomap {
 
@@ -36,6 +38,13 @@ struct DemoOptions {
   int height = 480;
   // Seed of the simulation (textures, odometry errors, noise).
   uint64_t seed = 1;
+  // The calibration the map is built from and the second traversal is
+  // localized with; empty: the simulator's true lens. A wrong one shows
+  // what lens self-calibration recovers (mapping.bundle_adjustment.
+  // intrinsics). Its size must be the simulated images'.
+  std::optional<Camera> given_camera;
+  // Mapping options (show_progress follows the field below).
+  MappingOptions mapping;
   // How the map is compared with the simulator's true planes.
   StructureAccuracyOptions structure;
   // Frame offset of the relative pose error (30 frames = 1 s at 30 Hz).

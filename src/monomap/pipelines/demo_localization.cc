@@ -66,6 +66,7 @@ DemoLocalization RunDemoLocalization(const Map& map,
   sim.path.lateral_offset_m = options.lateral_offset_m;
   out.simulate_seconds = Simulate(sim, dataset_dir).seconds;
   Dataset live = LoadDataset(dataset_dir);
+  if (options.given_camera) live.camera = *options.given_camera;
   out.frames = static_cast<int>(live.frames.size());
   for (const DatasetFrame& f : live.frames) {
     if (!f.groundtruth_world_from_cam) {
@@ -85,8 +86,9 @@ DemoLocalization RunDemoLocalization(const Map& map,
       images.push_back(live.LoadImage(i));
       frames.push_back(i);
     }
-    out.fidelity = EvaluateRenderFidelity(map, live.camera, poses, images,
-                                          frames, options.fidelity);
+    out.fidelity =
+        EvaluateRenderFidelity(map, LensForLocalization(map, live.camera),
+                               poses, images, frames, options.fidelity);
   }
 
   // The localizer never sees the traversal's ground truth.

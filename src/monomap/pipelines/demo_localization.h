@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -39,6 +40,10 @@ struct DemoLocalizationOptions {
   // particles over the whole hallway often lock onto one of them, 3000
   // cover it densely enough (docs/design-notes.md, "particle budget").
   int particles = 3000;
+  // The traversal's calibration as the localizer is told it; empty: the
+  // simulator's true lens. The map's refined lens replaces it when the map
+  // was built from this very calibration (LensForLocalization).
+  std::optional<Camera> given_camera;
   // Particles kept per step for the report (a random subset keeps the
   // page small).
   int plotted_particles = 400;

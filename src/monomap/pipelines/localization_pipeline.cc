@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "monomap/io/map_format.h"
+#include "monomap/pipelines/mapping_pipeline.h"
 #include "monomap/util/error.h"
 #include "monomap/util/progress.h"
 
@@ -20,6 +21,7 @@ nlohmann::json LocalizationReport::ToJson() const {
   j["mean_step_seconds"] = mean_step_seconds;
   j["mean_particles"] = mean_particles;
   j["mcc_accepted"] = mcc_accepted;
+  j["map_lens"] = map_lens;
   if (has_errors) {
     j["rmse_translation_m"] = rmse_translation_m;
     j["mean_rotation_error_deg"] = mean_rotation_error_deg;
@@ -106,6 +108,13 @@ void AddErrors(const Dataset& dataset, const std::vector<TimedPose>& estimate,
 
 }  // namespace
 
+Camera LensForLocalization(const Map& map, const Camera& live, bool* from_map) {
+  const bool use_map =
+      map.given_camera && SameCalibration(*map.given_camera, live);
+  if (from_map) *from_map = use_map;
+  return use_map ? map.camera : live;
+}
+
 LocalizationReport LocalizeSequence(
     const Map& map, const Dataset& dataset,
     const LocalizationPipelineOptions& options,
@@ -119,11 +128,12 @@ LocalizationReport LocalizeSequence(
   SessionOptions session_options;
   session_options.localizer = options.localizer;
   session_options.output_particles = particle_sets != nullptr;
+  LocalizationReport report;
   LocalizationSession session(
-      std::shared_ptr<const Map>(&map, [](const Map*) {}), dataset.camera,
+      std::shared_ptr<const Map>(&map, [](const Map*) {}),
+      LensForLocalization(map, dataset.camera, &report.map_lens),
       session_options, dataset.base_from_cam);
 
-  LocalizationReport report;
   std::vector<TimedPose> estimate;
   if (particle_sets) particle_sets->clear();
   ProgressBar progress("localize", dataset.frames.size(),
@@ -153,9 +163,10 @@ std::unique_ptr<LocalizationSession> OpenLocalizationSession(
     const std::optional<Camera>& live_camera,
     const std::optional<Rigid3d>& base_from_cam) {
   auto map = std::make_shared<const Map>(ReadMap(map_dir));
-  const Camera camera = live_camera ? *live_camera : map->camera;
-  return std::make_unique<LocalizationSession>(std::move(map), camera,
-                                               options, base_from_cam);
+  const Camera camera =
+      live_camera ? LensForLocalization(*map, *live_camera) : map->camera;
+  return std::make_unique<LocalizationSession>(std::move(map), camera, options,
+                                               base_from_cam);
 }
 
 }  // namespace monomap

@@ -38,6 +38,9 @@ struct LocalizationReport {
   double mean_step_seconds = 0.0;
   double mean_particles = 0.0;
   int mcc_accepted = 0;
+  // The map's refined lens was used instead of the dataset's calibration
+  // (LensForLocalization).
+  bool map_lens = false;
   // Against groundtruth, when the dataset has it (else 0 and false).
   bool has_errors = false;
   double rmse_translation_m = 0.0;
@@ -65,9 +68,18 @@ LocalizationReport LocalizeSequence(
     std::vector<TimedPose>* trajectory,
     std::vector<std::vector<Particle>>* particle_sets = nullptr);
 
+// The lens to localize with, given the live camera's calibration: the
+// map's own lens if the map was built from this very calibration and
+// bundle adjustment refined it (Map::given_camera equals `live`: the same
+// camera, better known now); otherwise `live` (another camera, or an
+// explicitly chosen calibration). *from_map (optional) says which.
+Camera LensForLocalization(const Map& map, const Camera& live,
+                           bool* from_map = nullptr);
+
 // A streaming session over the map in `map_dir` (io/map_format.h), for a
-// live robot. `live_camera`: the camera the images come from; empty: the
-// map's camera. Throws InputError if the map does not load.
+// live robot. `live_camera`: the camera the images come from (its refined
+// lens if the map holds one, LensForLocalization); empty: the map's camera.
+// Throws InputError if the map does not load.
 std::unique_ptr<LocalizationSession> OpenLocalizationSession(
     const std::filesystem::path& map_dir, const SessionOptions& options,
     const std::optional<Camera>& live_camera = {},

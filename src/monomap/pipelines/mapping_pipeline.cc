@@ -117,7 +117,8 @@ void TrackStage(const Dataset& dataset, const MappingOptions& options,
 
 // Stage 2: triangulation against the odometry poses, bundle adjustment and
 // triangulation again against the adjusted poses. Returns world_from_cam
-// per frame; *camera gets the distortion bundle adjustment settled on.
+// per frame; *camera gets the lens bundle adjustment settled on (the given
+// one, or its refined distortion or intrinsics).
 std::vector<Rigid3d> GeometryStage(const Dataset& dataset,
                                    const MappingOptions& options,
                                    const std::vector<Track>& tracks,
@@ -156,7 +157,7 @@ std::vector<Rigid3d> GeometryStage(const Dataset& dataset,
   ba.max_reprojection_error_px = loose.max_reprojection_error_px;
   report.bundle_adjustment = BundleAdjustKeyframes(
       *camera, tracks, ba, options.keyframes, &world_from_cam, &landmarks);
-  camera->distortion = report.bundle_adjustment.distortion;
+  *camera = report.bundle_adjustment.camera;
   report.timings.push_back({"bundle_adjustment", timer.ElapsedSeconds()});
   timer.Restart();
   report.retriangulation = TriangulateTracks(*camera, world_from_cam, tracks,
@@ -207,6 +208,12 @@ void SurfaceStages(const Dataset& dataset, const MappingOptions& options,
 
 }  // namespace
 
+bool SameCalibration(const Camera& a, const Camera& b) {
+  return a.model == b.model && a.width == b.width && a.height == b.height &&
+         a.fx == b.fx && a.fy == b.fy && a.cx == b.cx && a.cy == b.cy &&
+         a.distortion == b.distortion;
+}
+
 MappingResult BuildMap(const Dataset& dataset, const MappingOptions& options) {
   options.Check();
   Timer total;
@@ -217,8 +224,9 @@ MappingResult BuildMap(const Dataset& dataset, const MappingOptions& options) {
     throw StageError("need at least 2 frames to build a map, got " +
                      std::to_string(num_frames));
   }
-  // The dataset's calibration; bundle adjustment may refine its distortion,
-  // and every stage after it (and the map) uses the refined lens.
+  // The dataset's calibration; bundle adjustment may refine it (distortion,
+  // or the intrinsics), and every stage after it (and the map) uses the
+  // refined lens.
   Camera camera = dataset.camera;
   camera.Check();
   ThumbnailCache thumbs(num_frames);
@@ -236,6 +244,9 @@ MappingResult BuildMap(const Dataset& dataset, const MappingOptions& options) {
       GeometryStage(dataset, options, *tracks, &camera, &result);
   ColorLandmarks(thumbs, result.tracks, &result.map.landmarks);
   result.map.camera = camera;
+  if (!SameCalibration(camera, dataset.camera)) {
+    result.map.given_camera = dataset.camera;
+  }
   result.map.trajectory.reserve(num_frames);
   for (int i = 0; i < num_frames; ++i) {
     result.map.trajectory.push_back(
@@ -247,6 +258,33 @@ MappingResult BuildMap(const Dataset& dataset, const MappingOptions& options) {
   result.report.total_seconds = total.ElapsedSeconds();
   return result;
 }
+
+namespace {
+
+nlohmann::json LensJson(const std::array<double, kLensSize>& v) {
+  return {{"fx", v[kLensFx]}, {"fy", v[kLensFy]}, {"cx", v[kLensCx]},
+          {"cy", v[kLensCy]}, {"k1", v[kLensK1]}, {"k2", v[kLensK2]}};
+}
+
+// Lens self-calibration: refined or not and why, before and after, prior
+// and marginal standard deviations.
+nlohmann::json IntrinsicsJson(const IntrinsicsRefinementReport& r) {
+  if (!r.attempted) return {{"attempted", false}};
+  return {{"attempted", true},
+          {"refined", r.refined()},
+          {"focal_refined", r.group_refined[kGroupFocal]},
+          {"principal_point_refined", r.group_refined[kGroupPrincipalPoint]},
+          {"radial_refined", r.group_refined[kGroupRadial]},
+          {"reason", r.reason},
+          {"before", LensJson(LensParameters(r.before))},
+          {"after", LensJson(LensParameters(r.after))},
+          {"candidate", LensJson(r.candidate)},
+          {"prior_std", LensJson(r.prior_std)},
+          {"posterior_std", LensJson(r.posterior_std)},
+          {"covariance_seconds", r.covariance_seconds}};
+}
+
+}  // namespace
 
 nlohmann::json MappingReport::ToJson() const {
   nlohmann::json j;
@@ -296,7 +334,8 @@ nlohmann::json MappingReport::ToJson() const {
       {"linear_solver", bundle_adjustment.linear_solver},
       {"points_dropped", bundle_adjustment.num_dropped},
       {"mean_pose_change_m", bundle_adjustment.mean_pose_change_m},
-      {"mean_pose_change_deg", bundle_adjustment.mean_pose_change_deg}};
+      {"mean_pose_change_deg", bundle_adjustment.mean_pose_change_deg},
+      {"intrinsics", IntrinsicsJson(bundle_adjustment.intrinsics)}};
   nlohmann::json planes_json = {
       {"planes", planes.num_planes},
       {"outliers", planes.num_outliers},

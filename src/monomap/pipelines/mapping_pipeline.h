@@ -88,6 +88,9 @@ struct MappingResult {
   MappingReport report;
 };
 
+// Whether two calibrations are the same (every field equal).
+bool SameCalibration(const Camera& a, const Camera& b);
+
 // Builds the map. Throws InputError on bad data, StageError if a stage
 // cannot produce anything (e.g. no features).
 MappingResult BuildMap(const Dataset& dataset, const MappingOptions& options);

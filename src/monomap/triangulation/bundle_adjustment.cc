@@ -6,6 +6,8 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
 #include <algorithm>
 #include <cmath>
 #include <iostream>
@@ -67,15 +69,23 @@ struct ReprojectionCost {
     return Residual(pose, x, distortion, residual);
   }
 
-  template <typename T, typename D>
-  bool Residual(const T* pose, const T* x, const D* distortion,
-                T* residual) const {
+  // x_in_world -> *x_in_cam; false if the point is (nearly) on or behind
+  // the image plane: it has no projection, the step is rejected.
+  template <typename T>
+  static bool ToCamera(const T* pose, const T* x,
+                       Eigen::Matrix<T, 3, 1>* x_in_cam) {
     const Eigen::Map<const Eigen::Quaternion<T>> rotation(pose);
     const Eigen::Map<const Eigen::Matrix<T, 3, 1>> translation(pose + 4);
     const Eigen::Map<const Eigen::Matrix<T, 3, 1>> x_in_world(x);
-    const Eigen::Matrix<T, 3, 1> x_in_cam = rotation * x_in_world + translation;
-    // A point crossing the image plane has no projection: reject the step.
-    if (!(x_in_cam.z() > T(1e-6))) return false;
+    *x_in_cam = rotation * x_in_world + translation;
+    return x_in_cam->z() > T(1e-6);
+  }
+
+  template <typename T, typename D>
+  bool Residual(const T* pose, const T* x, const D* distortion,
+                T* residual) const {
+    Eigen::Matrix<T, 3, 1> x_in_cam;
+    if (!ToCamera(pose, x, &x_in_cam)) return false;
     T px[2];
     internal::ProjectWithDistortion(intrinsics, distortion, x_in_cam.data(),
                                     px);
@@ -96,6 +106,23 @@ struct ReprojectionCost {
   }
 
   internal::Intrinsics intrinsics;
+  Eigen::Vector2d observed;
+};
+
+// Reprojection error (raw pixels) with the lens block (fx, fy, cx, cy, k1,
+// k2) as a parameter (intrinsics_refinement.h).
+struct LensReprojectionCost {
+  template <typename T>
+  bool operator()(const T* pose, const T* x, const T* lens, T* residual) const {
+    Eigen::Matrix<T, 3, 1> x_in_cam;
+    if (!ReprojectionCost::ToCamera(pose, x, &x_in_cam)) return false;
+    T px[2];
+    internal::ProjectWithLens(constants, lens, x_in_cam.data(), px);
+    residual[0] = px[0] - observed.x();
+    residual[1] = px[1] - observed.y();
+    return true;
+  }
+  internal::LensConstants constants;
   Eigen::Vector2d observed;
 };
 
@@ -286,8 +313,25 @@ class BundleAdjuster {
   void WriteBackPoses(std::vector<Rigid3d>* world_from_cam);
   void RefineOtherLandmarks();
   void UpdateLandmarks(std::vector<Landmark>* landmarks);
+  // Lens self-calibration: before SetUpProblem, the groups (focal,
+  // principal point, radial) the adjustment refines (none: lens fixed).
+  void SetFreeLensGroups(const std::array<bool, kNumLensGroups>& groups);
+  // After Solve: marginal standard deviations of the lens block (0 for
+  // fixed parameters); false if Ceres cannot compute the covariance.
+  bool LensStandardDeviations(std::array<double, kLensSize>* stds);
+  const std::array<double, kLensSize>& lens() const { return lens_; }
 
  private:
+  bool LensFree() const { return lens_free_; }
+  // Prior and manifold (fixed groups constant) of the lens block.
+  void ParameterizeLens();
+  internal::LensConstants LensConstantsOf() const {
+    return {camera_.model == LensModel::kEquidistant,
+            {camera_.distortion[2], camera_.distortion[3],
+             camera_.distortion[4]},
+            options_.intrinsics.shared_focal,
+            camera_.fy / camera_.fx};
+  }
   void AddLandmarkToProblem(size_t i);
   // Odometry prior on the relative pose of poses i and j.
   void AddOdometryPrior(int i, int j, double translation_fraction,
@@ -305,6 +349,10 @@ class BundleAdjuster {
   std::vector<PoseParams> poses_;
   std::vector<Eigen::Vector3d> points_;
   std::array<double, 5> distortion_;
+  // Lens block (fx, fy, cx, cy, k1, k2) with self-calibration.
+  std::array<double, kLensSize> lens_;
+  std::array<bool, kNumLensGroups> free_groups_ = {false, false, false};
+  bool lens_free_ = false;
   std::vector<Rigid3d> cams_from_world_;
   std::vector<char> joint_;  // landmarks in the joint problem
   // Frames adjusted (first_ .. last_); frames outside follow by odometry.
@@ -332,6 +380,7 @@ BundleAdjuster::BundleAdjuster(const Camera& camera,
       poses_(num_frames_),
       points_(landmarks.size()),
       distortion_(camera.distortion),
+      lens_(LensParameters(camera)),
       cams_from_world_(num_frames_),
       adjusted_camera_(camera) {
   for (int i = 0; i < num_frames_; ++i) {
@@ -388,7 +437,13 @@ void BundleAdjuster::AddLandmarkToProblem(size_t i) {
   sum_squared_track_length_ += k * k;
   for (const Observation& obs : observations) {
     PoseParams& p = poses_[obs.frame];
-    if (options_.refine_distortion) {
+    if (LensFree()) {
+      auto* cost = new LensReprojectionCost{LensConstantsOf(), obs.px};
+      problem_.AddResidualBlock(
+          new ceres::AutoDiffCostFunction<LensReprojectionCost, 2, 7, 3,
+                                          kLensSize>(cost),
+          loss_, p.v, points_[i].data(), lens_.data());
+    } else if (options_.refine_distortion) {
       problem_.AddResidualBlock(
           ReprojectionCost::CreateWithDistortion(intrinsics_, obs.px), loss_,
           p.v, points_[i].data(), distortion_.data());
@@ -432,6 +487,7 @@ void BundleAdjuster::AddOdometryPriors() {
 }
 
 void BundleAdjuster::ParameterizePoses() {
+  if (LensFree()) ParameterizeLens();
   for (int i = first_; i <= last_; ++i) {
     if (problem_.HasParameterBlock(poses_[i].v)) {
       problem_.SetManifold(poses_[i].v, new PoseManifold);
@@ -473,6 +529,9 @@ ceres::Solver::Options BundleAdjuster::SetUpSolverOptions() {
       problem_.SetManifold(distortion_.data(),
                            new ceres::SubsetManifold(5, {4}));
     }
+  }
+  if (problem_.HasParameterBlock(lens_.data())) {
+    ordering->AddElementToGroup(lens_.data(), 1);
   }
   report_.covisibility =
       static_cast<double>(sum_squared_track_length_) / report_.num_residuals;
@@ -518,8 +577,14 @@ void BundleAdjuster::Solve(const ceres::Solver::Options& solver_options) {
   }
   // From here on (landmarks refined alone, errors, filtering) the refined
   // lens.
-  adjusted_camera_.distortion = distortion_;
-  report_.distortion = distortion_;
+  if (LensFree()) {
+    adjusted_camera_ =
+        WithLens(camera_, lens_, options_.intrinsics.shared_focal);
+  } else {
+    adjusted_camera_.distortion = distortion_;
+  }
+  report_.distortion = adjusted_camera_.distortion;
+  report_.camera = adjusted_camera_;
 }
 
 void BundleAdjuster::WriteBackPoses(std::vector<Rigid3d>* world_from_cam) {
@@ -587,6 +652,86 @@ void BundleAdjuster::UpdateLandmarks(std::vector<Landmark>* landmarks) {
   *landmarks = std::move(kept);
 }
 
+void BundleAdjuster::SetFreeLensGroups(
+    const std::array<bool, kNumLensGroups>& groups) {
+  free_groups_ = groups;
+  lens_free_ = groups[0] || groups[1] || groups[2];
+}
+
+// Parameters of the lens block held constant: those of the fixed groups,
+// and fy when it follows fx.
+std::vector<int> FixedLensParameters(
+    const std::array<bool, kNumLensGroups>& free_groups, bool shared_focal) {
+  std::vector<int> fixed;
+  if (!free_groups[kGroupFocal]) fixed = {kLensFx, kLensFy};
+  if (free_groups[kGroupFocal] && shared_focal) fixed.push_back(kLensFy);
+  if (!free_groups[kGroupPrincipalPoint]) {
+    fixed.insert(fixed.end(), {kLensCx, kLensCy});
+  }
+  if (!free_groups[kGroupRadial]) fixed.insert(fixed.end(), {kLensK1, kLensK2});
+  return fixed;
+}
+
+void BundleAdjuster::ParameterizeLens() {
+  if (!problem_.HasParameterBlock(lens_.data())) return;
+  internal::LensPriorCost* prior = new internal::LensPriorCost;
+  prior->given = LensParameters(camera_);
+  const auto sigmas = LensPriorSigmas(camera_, options_.intrinsics);
+  for (int k = 0; k < kLensSize; ++k) prior->inv_sigma[k] = 1.0 / sigmas[k];
+  problem_.AddResidualBlock(
+      new ceres::AutoDiffCostFunction<internal::LensPriorCost, kLensSize,
+                                      kLensSize>(prior),
+      nullptr, lens_.data());
+  const std::vector<int> fixed =
+      FixedLensParameters(free_groups_, options_.intrinsics.shared_focal);
+  if (!fixed.empty()) {
+    problem_.SetManifold(lens_.data(),
+                         new ceres::SubsetManifold(kLensSize, fixed));
+  }
+}
+
+bool BundleAdjuster::LensStandardDeviations(
+    std::array<double, kLensSize>* stds) {
+  stds->fill(0.0);
+  if (!problem_.HasParameterBlock(lens_.data())) return false;
+  // Marginal covariance of the lens block: the lens rows of the inverse of
+  // J^T J (Gauss-Newton Hessian, robust weights applied) over every free
+  // pose and point, by a sparse Cholesky factorization. The lens block
+  // comes first, so its tangent coordinates are the first columns.
+  ceres::Problem::EvaluateOptions evaluate;
+  evaluate.parameter_blocks = {lens_.data()};
+  std::vector<double*> blocks;
+  problem_.GetParameterBlocks(&blocks);
+  for (double* b : blocks) {
+    if (b != lens_.data() && !problem_.IsParameterBlockConstant(b)) {
+      evaluate.parameter_blocks.push_back(b);
+    }
+  }
+  evaluate.num_threads = options_.num_threads;
+  ceres::CRSMatrix crs;
+  if (!problem_.Evaluate(evaluate, nullptr, nullptr, nullptr, &crs)) {
+    return false;
+  }
+  const Eigen::Map<const Eigen::SparseMatrix<double, Eigen::RowMajor>> j(
+      crs.num_rows, crs.num_cols, static_cast<int>(crs.values.size()),
+      crs.rows.data(), crs.cols.data(), crs.values.data());
+  const Eigen::SparseMatrix<double> h = j.transpose() * j;
+  const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(h);
+  if (ldlt.info() != Eigen::Success) return false;
+  const std::vector<int> fixed =
+      FixedLensParameters(free_groups_, options_.intrinsics.shared_focal);
+  int column = 0;
+  for (int k = 0; k < kLensSize; ++k) {
+    if (std::find(fixed.begin(), fixed.end(), k) != fixed.end()) continue;
+    const Eigen::VectorXd x =
+        ldlt.solve(Eigen::VectorXd::Unit(crs.num_cols, column));
+    if (ldlt.info() != Eigen::Success || !(x[column] > 0.0)) return false;
+    (*stds)[k] = std::sqrt(x[column]);
+    ++column;
+  }
+  return true;
+}
+
 }  // namespace
 
 void BundleAdjustmentOptions::Check() const {
@@ -617,7 +762,81 @@ void BundleAdjustmentOptions::Check() const {
   CheckOption(max_reprojection_error_px > 0, "max_reprojection_error_px",
               "must be positive");
   CheckOption(min_depth_m > 0, "min_depth_m", "must be positive");
+  intrinsics.Check();
+  CheckOption(!(refine_distortion && intrinsics.enabled), "refine_distortion",
+              "and intrinsics.enabled exclude each other (both refine the "
+              "distortion)");
 }
+
+namespace {
+
+// The trial adjustment's lens block: marginal standard deviations,
+// candidate values and the judgement of each group, into *lens.
+void JudgeTrialLens(const Camera& camera,
+                    const BundleAdjustmentOptions& options,
+                    BundleAdjuster* adjuster,
+                    IntrinsicsRefinementReport* lens) {
+  const Timer timer;
+  const bool ok = adjuster->LensStandardDeviations(&lens->posterior_std);
+  if (!ok) lens->posterior_std.fill(-1.0);
+  lens->candidate = adjuster->lens();
+  lens->prior_std = LensPriorSigmas(camera, options.intrinsics);
+  if (options.intrinsics.shared_focal) lens->prior_std[kLensFy] = 0.0;
+  JudgeLensGroups(options.intrinsics, ok, lens);
+  lens->covariance_seconds = timer.ElapsedSeconds();
+}
+
+// One adjustment with the given lens groups free (none: lens fixed). With
+// `lens` (the trial of self-calibration), the lens block is judged after
+// the solve (JudgeTrialLens); if it rejects a free group, nothing is
+// written back and false is returned: the caller adjusts again with the
+// accepted groups only.
+bool AdjustOnce(const Camera& camera, const std::vector<Track>& tracks,
+                const BundleAdjustmentOptions& options,
+                const std::array<bool, kNumLensGroups>& free_groups,
+                IntrinsicsRefinementReport* lens,
+                std::vector<Rigid3d>* world_from_cam,
+                std::vector<Landmark>* landmarks,
+                BundleAdjustmentReport* report) {
+  const Timer timer;
+  *report = BundleAdjustmentReport();
+  report->distortion = camera.distortion;
+  report->camera = camera;
+  report->num_points = static_cast<int>(landmarks->size());
+  const int num_frames = static_cast<int>(world_from_cam->size());
+  BundleAdjuster adjuster(camera, options,
+                          MatchLandmarkTracks(tracks, *landmarks, num_frames),
+                          *world_from_cam, *landmarks, report);
+  adjuster.SetFreeLensGroups(free_groups);
+  const bool nothing_to_adjust = landmarks->empty() || num_frames == 0;
+  if (!options.enabled || nothing_to_adjust || !adjuster.SetUpProblem()) {
+    if (options.enabled && !nothing_to_adjust) {
+      // Every landmark was behind a camera: all dropped.
+      report->num_dropped = static_cast<int>(landmarks->size());
+      landmarks->clear();
+    }
+    report->final_rms_error_px = report->initial_rms_error_px;
+    report->final_median_error_px = report->initial_median_error_px;
+    report->termination = options.enabled ? "nothing to adjust" : "disabled";
+    report->seconds = timer.ElapsedSeconds();
+    if (lens) lens->reason = "lens kept: nothing to adjust";
+    return true;
+  }
+  adjuster.AddOdometryPriors();
+  adjuster.ParameterizePoses();
+  adjuster.Solve(adjuster.SetUpSolverOptions());
+  if (lens) {
+    JudgeTrialLens(camera, options, &adjuster, lens);
+    if (lens->group_refined != free_groups) return false;
+  }
+  adjuster.WriteBackPoses(world_from_cam);
+  adjuster.RefineOtherLandmarks();
+  adjuster.UpdateLandmarks(landmarks);
+  report->seconds = timer.ElapsedSeconds();
+  return true;
+}
+
+}  // namespace
 
 BundleAdjustmentReport BundleAdjust(const Camera& camera,
                                     const std::vector<Track>& tracks,
@@ -627,32 +846,26 @@ BundleAdjustmentReport BundleAdjust(const Camera& camera,
   options.Check();
   camera.Check();
   const Timer timer;
+  IntrinsicsRefinementReport lens;
+  lens.before = camera;
+  const IntrinsicsRefinementOptions& io = options.intrinsics;
   BundleAdjustmentReport report;
-  report.distortion = camera.distortion;
-  report.num_points = static_cast<int>(landmarks->size());
-  const int num_frames = static_cast<int>(world_from_cam->size());
-  BundleAdjuster adjuster(camera, options,
-                          MatchLandmarkTracks(tracks, *landmarks, num_frames),
-                          *world_from_cam, *landmarks, &report);
-  const bool nothing_to_adjust = landmarks->empty() || num_frames == 0;
-  if (!options.enabled || nothing_to_adjust || !adjuster.SetUpProblem()) {
-    if (options.enabled && !nothing_to_adjust) {
-      // Every landmark was behind a camera: all dropped.
-      report.num_dropped = static_cast<int>(landmarks->size());
-      landmarks->clear();
-    }
-    report.final_rms_error_px = report.initial_rms_error_px;
-    report.final_median_error_px = report.initial_median_error_px;
-    report.termination = options.enabled ? "nothing to adjust" : "disabled";
-    report.seconds = timer.ElapsedSeconds();
-    return report;
+  bool done = false;
+  if (options.enabled && io.enabled) {
+    // Trial with the chosen groups free under their prior; kept if every
+    // group passes the judgement, else adjusted again without the others.
+    lens.attempted = true;
+    done = AdjustOnce(
+        camera, tracks, options,
+        {io.refine_focal, io.refine_principal_point, io.refine_radial}, &lens,
+        world_from_cam, landmarks, &report);
   }
-  adjuster.AddOdometryPriors();
-  adjuster.ParameterizePoses();
-  adjuster.Solve(adjuster.SetUpSolverOptions());
-  adjuster.WriteBackPoses(world_from_cam);
-  adjuster.RefineOtherLandmarks();
-  adjuster.UpdateLandmarks(landmarks);
+  if (!done) {
+    AdjustOnce(camera, tracks, options, lens.group_refined, nullptr,
+               world_from_cam, landmarks, &report);
+  }
+  lens.after = report.camera;
+  report.intrinsics = lens;
   report.seconds = timer.ElapsedSeconds();
   return report;
 }

@@ -10,8 +10,10 @@
 //    grow with the step length. A monocular camera cannot observe scale: the
 //    priors keep it (and keep unobserved frames in place).
 // The first pose is held fixed (the odometry is anchored at it), which fixes
-// the gauge. Focal length and principal point are not refined; the lens
-// distortion is if refine_distortion is set.
+// the gauge. The lens is held fixed, unless refine_distortion (all five
+// distortion coefficients, no prior) or intrinsics.enabled (focal length,
+// principal point, k1, k2 under a prior, trusted only where the data
+// constrain them: intrinsics_refinement.h) is set.
 #pragma once
 
 #include <array>
@@ -21,6 +23,7 @@
 #include "monomap/camera/camera.h"
 #include "monomap/geometry/rigid3.h"
 #include "monomap/map/map.h"
+#include "monomap/triangulation/intrinsics_refinement.h"
 
 namespace monomap {
 
@@ -62,6 +65,9 @@ struct BundleAdjustmentOptions {
   // calibration refitted on board views (`monomap calibrate`) is the better
   // fix (figures: docs/benchmarks.md).
   bool refine_distortion = false;
+  // Lens self-calibration (focal, principal point, k1, k2) under a prior;
+  // exclusive with refine_distortion.
+  IntrinsicsRefinementOptions intrinsics;
   // Hold the first pose fixed (gauge). If false, the first pose gets an
   // absolute prior with the floor sigmas instead.
   bool fix_first_pose = true;
@@ -133,6 +139,10 @@ struct BundleAdjustmentReport {
   // Distortion (k1, k2, p1, p2, k3) the final poses and points go with: the
   // camera's, or the refined one.
   std::array<double, 5> distortion = {0, 0, 0, 0, 0};
+  // The whole camera the final poses and points go with.
+  Camera camera;
+  // Lens self-calibration: refined or not, why, before and after.
+  IntrinsicsRefinementReport intrinsics;
   int num_dropped = 0;                // landmarks dropped after adjustment
   double mean_pose_change_m = 0.0;    // mean camera centre displacement
   double mean_pose_change_deg = 0.0;  // mean rotation change

@@ -50,27 +50,39 @@ inline void DistortEquidistant(const D* k, const T& x, const T& y, T* xd,
   *yd = y * scale;
 }
 
+// Plumb_bob normalized -> distorted with k1, k2, p1, p2, k3.
+template <typename T, typename D>
+inline void DistortPlumbBob(const D* distortion, const T& x, const T& y, T* xd,
+                            T* yd) {
+  const D &k1 = distortion[0], &k2 = distortion[1], &p1 = distortion[2],
+          &p2 = distortion[3], &k3 = distortion[4];
+  const T r2 = x * x + y * y;
+  const T radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3));
+  *xd = x * radial + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x);
+  *yd = y * radial + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y;
+}
+
+// Undistorted normalized (x, y) -> distorted normalized (*xd, *yd) with the
+// five coefficients of the lens model (equidistant or plumb_bob).
+template <typename T, typename D>
+inline void DistortNormalized(bool equidistant, const D* distortion, const T& x,
+                              const T& y, T* xd, T* yd) {
+  if (equidistant) {
+    DistortEquidistant(distortion, x, y, xd, yd);
+  } else {
+    DistortPlumbBob(distortion, x, y, xd, yd);
+  }
+}
+
 // Camera-frame point -> raw pixel (px[0], px[1]) with the five distortion
 // coefficients of the camera's lens model given apart (double, or ceres::Jet
 // when bundle adjustment refines them). Caller checks z > 0.
 template <typename T, typename D>
 inline void ProjectWithDistortion(const Intrinsics& in, const D* distortion,
                                   const T* x_in_cam, T* px) {
-  const T x = x_in_cam[0] / x_in_cam[2];
-  const T y = x_in_cam[1] / x_in_cam[2];
-  if (in.equidistant) {
-    T xd, yd;
-    DistortEquidistant(distortion, x, y, &xd, &yd);
-    px[0] = in.v[0] * xd + in.v[2];
-    px[1] = in.v[1] * yd + in.v[3];
-    return;
-  }
-  const D &k1 = distortion[0], &k2 = distortion[1], &p1 = distortion[2],
-          &p2 = distortion[3], &k3 = distortion[4];
-  const T r2 = x * x + y * y;
-  const T radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3));
-  const T xd = x * radial + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x);
-  const T yd = y * radial + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y;
+  T xd, yd;
+  DistortNormalized(in.equidistant, distortion, T(x_in_cam[0] / x_in_cam[2]),
+                    T(x_in_cam[1] / x_in_cam[2]), &xd, &yd);
   px[0] = in.v[0] * xd + in.v[2];
   px[1] = in.v[1] * yd + in.v[3];
 }

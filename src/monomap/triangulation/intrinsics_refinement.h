@@ -1,0 +1,144 @@
+// Lens self-calibration inside bundle adjustment: the focal length, the
+// principal point and the radial distortion (k1, k2) become one parameter
+// block of the adjustment, held by a Gaussian prior at the given calibration
+// (its uncertainty as sigmas). The data move a parameter only as far as they
+// outweigh the prior, and afterwards each group (focal, principal point,
+// radial) is trusted only if the data shrank its marginal standard deviation
+// (from the Hessian, ceres::Covariance) well below the prior's and its
+// change is plausible. Rejected groups keep the given values and the
+// adjustment is solved again without them: a scene that does not constrain
+// the lens (forward motion, a single plane, few points) keeps the given
+// calibration, and the report says why.
+//
+// The lens block is (fx, fy, cx, cy, k1, k2); the other three distortion
+// coefficients stay as given (plumb_bob p1, p2, k3; equidistant k3, k4, 0).
+// The same block serves both lens models: their first two coefficients are
+// the leading radial terms (in r^2 for plumb_bob, in theta^2 for
+// equidistant).
+#pragma once
+
+#include <array>
+#include <string>
+
+#include "monomap/camera/camera.h"
+#include "monomap/triangulation/projection.h"
+
+namespace monomap {
+
+struct IntrinsicsRefinementOptions {
+  // Refine focal length, principal point and k1, k2 with the poses and
+  // points (when the data constrain them). Off by default: figures in
+  // docs/benchmarks.md.
+  bool enabled = false;
+  // Groups the trial may refine (a group left out keeps the given values).
+  // Focal length and principal point are off by default: on simulated
+  // hallways their marginal std is small but they converge ~0.5% / ~5 px
+  // off the truth whatever the start (a bias the covariance cannot show);
+  // k1, k2 converge to the truth (figures: docs/benchmarks.md).
+  bool refine_focal = false;
+  bool refine_principal_point = false;
+  bool refine_radial = true;
+  // One focal length for both axes (the given fy/fx ratio is kept).
+  bool shared_focal = true;
+  // Prior sigma of the focal length, as a fraction of the given fx (fy).
+  double focal_sigma_fraction = 0.02;
+  // Prior sigma of the principal point (px), as a fraction of the width.
+  double principal_point_sigma_fraction = 0.02;
+  // Prior sigmas of the radial coefficients k1 and k2.
+  double k1_sigma = 0.05;
+  double k2_sigma = 0.05;
+  // A group is trusted only if the data shrank its marginal standard
+  // deviation to at most this fraction of the prior sigma (0.5: the data
+  // carry at least 3 times the prior's information) ...
+  double max_posterior_to_prior_std = 0.5;
+  // ... and it moved at most this many prior sigmas (farther means the
+  // given calibration or the adjustment is wrong: keep the given one).
+  double max_change_prior_sigmas = 4.0;
+  // Throws OptionsError naming the field if a value makes no sense.
+  void Check() const;
+};
+
+// Index of the lens block's parameters.
+enum LensIndex { kLensFx, kLensFy, kLensCx, kLensCy, kLensK1, kLensK2 };
+constexpr int kLensSize = 6;
+// Groups judged (and refined or kept) together.
+enum LensGroup { kGroupFocal, kGroupPrincipalPoint, kGroupRadial };
+constexpr int kNumLensGroups = 3;
+
+struct IntrinsicsRefinementReport {
+  bool attempted = false;  // options.enabled
+  // Groups refined: focal, principal point, radial (k1, k2).
+  std::array<bool, kNumLensGroups> group_refined = {false, false, false};
+  bool refined() const {
+    return group_refined[0] || group_refined[1] || group_refined[2];
+  }
+  // Why each group was refined or kept, one sentence per group.
+  std::string reason;
+  Camera before;  // the given calibration
+  Camera after;   // the one the poses and points go with
+  // Prior and marginal (posterior) standard deviations of fx, fy, cx, cy,
+  // k1, k2 from the trial adjustment; 0 if held fixed, posterior -1 if the
+  // covariance could not be computed.
+  std::array<double, kLensSize> prior_std = {0, 0, 0, 0, 0, 0};
+  std::array<double, kLensSize> posterior_std = {0, 0, 0, 0, 0, 0};
+  // Values after the trial adjustment.
+  std::array<double, kLensSize> candidate = {0, 0, 0, 0, 0, 0};
+  double covariance_seconds = 0.0;
+};
+
+// The lens block of a camera, and the camera with a lens block applied
+// (distortion[2..4] unchanged).
+std::array<double, kLensSize> LensParameters(const Camera& camera);
+Camera WithLens(const Camera& camera, const std::array<double, kLensSize>& lens,
+                bool shared_focal);
+
+// Prior sigmas of the lens block for the given camera.
+std::array<double, kLensSize> LensPriorSigmas(
+    const Camera& camera, const IntrinsicsRefinementOptions& options);
+
+// Which groups to trust, from the trial adjustment's candidate values and
+// marginal standard deviations (posterior_ok false: the covariance could
+// not be computed, nothing is trusted); groups the options do not refine
+// stay kept. Fills report->group_refined and report->reason.
+void JudgeLensGroups(const IntrinsicsRefinementOptions& options,
+                     bool posterior_ok, IntrinsicsRefinementReport* report);
+
+namespace internal {
+
+// Camera-frame point -> raw pixel with the lens block (fx, fy, cx, cy, k1,
+// k2) as parameters and the camera's distortion[2..4] fixed; with a shared
+// focal, fy = fx * fy_over_fx. Caller checks z > 0.
+struct LensConstants {
+  bool equidistant = false;            // lens model (else plumb_bob)
+  std::array<double, 3> fixed_tail{};  // distortion[2..4]
+  bool shared_focal = true;
+  double fy_over_fx = 1.0;
+};
+template <typename T>
+inline void ProjectWithLens(const LensConstants& c, const T* lens,
+                            const T* x_in_cam, T* px) {
+  const T distortion[5] = {lens[kLensK1], lens[kLensK2], T(c.fixed_tail[0]),
+                           T(c.fixed_tail[1]), T(c.fixed_tail[2])};
+  T xd, yd;
+  DistortNormalized(c.equidistant, distortion, T(x_in_cam[0] / x_in_cam[2]),
+                    T(x_in_cam[1] / x_in_cam[2]), &xd, &yd);
+  const T fy = c.shared_focal ? lens[kLensFx] * c.fy_over_fx : lens[kLensFy];
+  px[0] = lens[kLensFx] * xd + lens[kLensCx];
+  px[1] = fy * yd + lens[kLensCy];
+}
+
+// Gaussian prior on the lens block: (lens - given) / sigma per parameter.
+struct LensPriorCost {
+  std::array<double, kLensSize> given;
+  std::array<double, kLensSize> inv_sigma;
+  template <typename T>
+  bool operator()(const T* lens, T* residual) const {
+    for (int k = 0; k < kLensSize; ++k) {
+      residual[k] = (lens[k] - T(given[k])) * T(inv_sigma[k]);
+    }
+    return true;
+  }
+};
+
+}  // namespace internal
+}  // namespace monomap
