@@ -144,14 +144,18 @@ std::string ImageSizeLimitError(int64_t width, int64_t height) {
 
 cv::Mat ReadImageFile(const std::filesystem::path& path, int flags) {
   const std::string bytes = ReadFileToString(path);
-  const std::vector<uint8_t> data(bytes.begin(), bytes.end());
-  if (data.empty()) throw InputError(path.string() + ": image file is empty");
+  return DecodeImageBytes(std::vector<uint8_t>(bytes.begin(), bytes.end()),
+                          flags, path.string());
+}
+
+cv::Mat DecodeImageBytes(const std::vector<uint8_t>& data, int flags,
+                         const std::string& where) {
+  if (data.empty()) throw InputError(where + ": image file is empty");
   if (StartsWith(data, {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'})) {
     if (data.size() < kPngEnd.size() ||
         !std::equal(kPngEnd.begin(), kPngEnd.end(),
                     data.end() - kPngEnd.size())) {
-      throw InputError(path.string() +
-                       ": truncated PNG (no IEND chunk at the end)");
+      throw InputError(where + ": truncated PNG (no IEND chunk at the end)");
     }
   } else if (StartsWith(data, {0xFF, 0xD8, 0xFF})) {
     const size_t from =
@@ -161,33 +165,31 @@ cv::Mat ReadImageFile(const std::filesystem::path& path, int flags) {
       has_end = data[i - 1] == 0xFF && data[i] == 0xD9;
     }
     if (!has_end) {
-      throw InputError(path.string() +
-                       ": truncated JPEG (no end-of-image marker)");
+      throw InputError(where + ": truncated JPEG (no end-of-image marker)");
     }
   }
   int64_t width = 0, height = 0;
   const bool is_jpeg = JpegSize(data, &width, &height);
   if (is_jpeg || PngSize(data, &width, &height)) {
     const std::string error = ImageSizeLimitError(width, height);
-    if (!error.empty()) throw InputError(path.string() + ": image " + error);
+    if (!error.empty()) throw InputError(where + ": image " + error);
   }
   if (is_jpeg) {
     // An end marker appended to a truncated JPEG passes the check above;
     // libjpeg then only warns and fills the missing part with grey.
     const std::string problem = JpegDecodeProblem(data);
     if (!problem.empty()) {
-      throw InputError(path.string() +
-                       ": JPEG does not decode completely: " + problem);
+      throw InputError(where + ": JPEG does not decode completely: " + problem);
     }
   }
   cv::Mat image;
   try {
     image = cv::imdecode(data, flags);
   } catch (const cv::Exception& e) {  // e.g. OpenCV's own pixel limit
-    throw InputError(path.string() + ": cannot decode image: " + e.err);
+    throw InputError(where + ": cannot decode image: " + e.err);
   }
   if (image.empty()) {
-    throw InputError(path.string() + ": cannot decode image");
+    throw InputError(where + ": cannot decode image");
   }
   return image;
 }

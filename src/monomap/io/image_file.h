@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <opencv2/core.hpp>
 #include <string>
+#include <vector>
 
 namespace monomap {
 
@@ -27,5 +28,10 @@ std::string ImageSizeLimitError(int64_t width, int64_t height);
 // decoding), or cannot be decoded. Other formats are left to OpenCV (whose
 // own pixel limit is turned into an InputError too).
 cv::Mat ReadImageFile(const std::filesystem::path& path, int flags);
+
+// The same checks and decoding for an image held in memory (e.g. a bag's
+// CompressedImage); `where` names it in errors (a file, or file and topic).
+cv::Mat DecodeImageBytes(const std::vector<uint8_t>& data, int flags,
+                         const std::string& where);
 
 }  // namespace monomap
