@@ -2,6 +2,8 @@
 #   make demo   install missing Debian packages, build, run the demo
 #   make test   install missing Debian packages, build, run all tests
 #   make test-sanitize   the test suite under ASan+UBSan (build-asan)
+#   make test-sanitize-parsers   the util, camera and io tests under
+#               ASan+UBSan (build-fuzz; what CI runs)
 #   make fuzz   build the libFuzzer targets (build-fuzz), run each for
 #               FUZZ_SECONDS on fuzz/corpus/<target>; non-zero on a finding
 BUILD_DIR ?= build
@@ -31,7 +33,8 @@ FUZZ_TARGETS = camera_yaml camera_mount dataset feature_table image map ply
 
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
-.PHONY: deps sanitize-deps configure build test test-sanitize fuzz demo bench clean
+.PHONY: deps sanitize-deps configure build test test-sanitize fuzz-configure \
+  test-sanitize-parsers fuzz demo bench clean
 
 deps:
 	@missing=$$(for p in $(DEB_PACKAGES); do \
@@ -67,24 +70,50 @@ test-sanitize: sanitize-deps
 	  UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 \
 	  ctest --output-on-failure -j $(JOBS)
 
-# Each target runs FUZZ_SECONDS on a copy of its checked-in corpus (new
-# inputs land in $(FUZZ_DIR)/corpus, not in the source tree); crash files
-# go to $(FUZZ_DIR)/findings.
-fuzz: sanitize-deps
-	@[ -f $(FUZZ_DIR)/build.ninja ] || \
-	  CXX=clang++ cmake -S . -B $(FUZZ_DIR) -G Ninja \
-	    -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMONOMAP_BUILD_FUZZERS=ON \
-	    -DMONOMAP_BUILD_TESTS=OFF -DMONOMAP_BUILD_BENCH=OFF
+# The clang build of `make fuzz` and `make test-sanitize-parsers`
+# (build-fuzz): ASan+UBSan and libFuzzer's coverage instrumentation on
+# everything; tests are configured too, so that one build serves both.
+# Configured every time (cheap): a build-fuzz of an older Makefile had
+# tests off.
+fuzz-configure: sanitize-deps
+	CC=clang CXX=clang++ cmake -S . -B $(FUZZ_DIR) -G Ninja \
+	  -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMONOMAP_BUILD_FUZZERS=ON \
+	  -DMONOMAP_BUILD_TESTS=ON -DMONOMAP_BUILD_BENCH=OFF >/dev/null
+
+# The unit tests of the parsing modules under ASan+UBSan, in the fuzz
+# build: what CI runs of the sanitizers (`make test-sanitize` builds and
+# runs everything, too long for CI). Each runs in its build folder, as
+# ctest runs it.
+SANITIZE_MODULES = util camera io
+test-sanitize-parsers: fuzz-configure
+	cmake --build $(FUZZ_DIR) -j $(JOBS) --target \
+	  $(addsuffix _test,$(SANITIZE_MODULES))
+	@status=0; for m in $(SANITIZE_MODULES); do \
+	  echo "== $${m}_test (ASan+UBSan)"; \
+	  (cd $(FUZZ_DIR)/src/monomap/$$m && \
+	   ASAN_OPTIONS=halt_on_error=1:detect_leaks=1 \
+	   UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 \
+	   ./$${m}_test --gtest_brief=1) || status=1; \
+	done; exit $$status
+
+# Each target first runs every file of its checked-in corpus (so a
+# regression of a past finding fails at once), then FUZZ_SECONDS of new
+# inputs on a copy of it (new inputs land in $(FUZZ_DIR)/corpus, not in
+# the source tree); crash files go to $(FUZZ_DIR)/findings, the log to
+# $(FUZZ_DIR)/<target>.log (its tail is printed on a finding).
+fuzz: fuzz-configure
 	cmake --build $(FUZZ_DIR) -j $(JOBS) --target \
 	  $(addsuffix _fuzzer,$(FUZZ_TARGETS))
 	@mkdir -p $(FUZZ_DIR)/findings; status=0; \
 	for t in $(FUZZ_TARGETS); do \
 	  mkdir -p $(FUZZ_DIR)/corpus/$$t; \
 	  echo "== $${t}_fuzzer: $(FUZZ_SECONDS) s"; \
-	  $(FUZZ_DIR)/fuzz/$${t}_fuzzer -max_total_time=$(FUZZ_SECONDS) \
-	    -timeout=10 -rss_limit_mb=$(FUZZ_RSS_MB) -print_final_stats=1 \
-	    -artifact_prefix=$(FUZZ_DIR)/findings/$${t}- \
-	    $(FUZZ_DIR)/corpus/$$t fuzz/corpus/$$t || status=1; \
+	  if $(FUZZ_DIR)/fuzz/$${t}_fuzzer -max_total_time=$(FUZZ_SECONDS) \
+	      -timeout=10 -rss_limit_mb=$(FUZZ_RSS_MB) -print_final_stats=1 \
+	      -artifact_prefix=$(FUZZ_DIR)/findings/$${t}- \
+	      $(FUZZ_DIR)/corpus/$$t fuzz/corpus/$$t >$(FUZZ_DIR)/$$t.log 2>&1; \
+	  then grep -E "INITED|DONE|number_of_executed_units" $(FUZZ_DIR)/$$t.log; \
+	  else status=1; tail -n 80 $(FUZZ_DIR)/$$t.log; fi; \
 	done; exit $$status
 
 demo: build

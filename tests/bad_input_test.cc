@@ -1,14 +1,12 @@
-// The bad-input catalogue (docs/reliability.md): each class of hostile or
-// corrupt input, generated here, run through the `monomap` binary. Every
-// case must end in under a minute with exit code 1 (bad input; never 4),
-// a message naming the file, and no output written.
+// The bad-input catalogue (docs/reliability.md) of datasets and maps: each
+// class of hostile or corrupt input, generated here, run through the
+// `monomap` binary (tests/bad_input_catalogue.h says what each must give).
+// The importers' inputs are in bad_import_test.
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 
-#include <chrono>
 #include <filesystem>
 #include <fstream>
-#include <functional>
 #include <opencv2/imgcodecs.hpp>
 #include <string>
 #include <vector>
@@ -16,20 +14,15 @@
 #include "monomap/io/map_format.h"
 #include "monomap/sim/simulate.h"
 #include "monomap/util/file.h"
+#include "tests/bad_input_catalogue.h"
 #include "tests/monomap_cli.h"
 
 namespace monomap {
 namespace {
 namespace fs = std::filesystem;
+using test::Case;
 using test::RunMonomap;
 using test::RunResult;
-
-struct Case {
-  std::string name;
-  // Corrupts the copy of the good input (a dataset or a map directory).
-  std::function<void(const fs::path& dir)> corrupt;
-  std::string named;  // text the message must contain (the file, ...)
-};
 
 void Append(const fs::path& file, const std::string& text) {
   std::ofstream(file, std::ios::app) << text;
@@ -126,33 +119,10 @@ class BadInput : public ::testing::Test {
     WriteMap(dir, map);
   }
 
-  // Runs `command` (with INPUT and OUT replaced) on a corrupted copy of
-  // `good` for each case and checks the outcome.
   static void RunCatalogue(const std::string& good, const std::string& command,
                            const std::vector<Case>& cases,
                            const std::string& out_extension = "") {
-    for (const Case& c : cases) {
-      SCOPED_TRACE(c.name);
-      const fs::path input = *root_ / ("in_" + c.name);
-      fs::remove_all(input);
-      fs::copy(*root_ / good, input, fs::copy_options::recursive);
-      c.corrupt(input);
-      const fs::path out = *root_ / ("out_" + c.name + out_extension);
-      std::string line = command;
-      line.replace(line.find("INPUT"), 5, input.string());
-      line.replace(line.find("OUT"), 3, out.string());
-      const auto start = std::chrono::steady_clock::now();
-      const RunResult r = RunMonomap(line);
-      const double seconds = std::chrono::duration<double>(
-                                 std::chrono::steady_clock::now() - start)
-                                 .count();
-      EXPECT_EQ(r.exit_code, 1) << r.output;  // bad input, never 4
-      EXPECT_EQ(r.output.find("internal error"), std::string::npos) << r.output;
-      EXPECT_NE(r.output.find(c.named), std::string::npos) << r.output;
-      EXPECT_LT(seconds, 60.0);
-      EXPECT_FALSE(fs::exists(out)) << "output written";
-      fs::remove_all(input);
-    }
+    test::RunCatalogue(*root_, good, command, cases, out_extension);
   }
   static fs::path* root_;
 };

@@ -8,7 +8,9 @@
 #include <optional>
 
 #include "monomap/io/camera_mount.h"
+#include "monomap/io/dataset.h"
 #include "monomap/io/dataset_writer.h"
+#include "monomap/io/image_file.h"
 #include "monomap/io/trajectory_io.h"
 #include "monomap/util/error.h"
 #include "monomap/util/file.h"
@@ -110,6 +112,16 @@ std::string Frame(const std::string& name) {
   return !name.empty() && name[0] == '/' ? name.substr(1) : name;
 }
 
+// A stamp or length in messages, to the nanosecond without trailing zeros.
+std::string FormatStamp(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof(buf), "%.9f", v);
+  std::string text = buf;
+  while (text.size() > 1 && text.back() == '0') text.pop_back();
+  if (text.back() == '.') text.pop_back();
+  return text;
+}
+
 // The bag's topics and their message types.
 class BagTopics {
  public:
@@ -147,15 +159,13 @@ class BagTopics {
 };
 
 struct Odometry {
-  std::vector<TimedPose> world_from_base;  // sorted, unique stamps
+  std::vector<TimedPose> world_from_base;  // increasing stamps
   std::string child_frame;
 };
 
-void SortUnique(std::vector<TimedPose>& poses) {
-  std::stable_sort(poses.begin(), poses.end(),
-                   [](const TimedPose& a, const TimedPose& b) {
-                     return a.timestamp < b.timestamp;
-                   });
+// Stamps are non-decreasing (AppendOdometry); a republished stamp keeps
+// its first pose.
+void DropRepeatedStamps(std::vector<TimedPose>& poses) {
   poses.erase(std::unique(poses.begin(), poses.end(),
                           [](const TimedPose& a, const TimedPose& b) {
                             return a.timestamp == b.timestamp;
@@ -163,14 +173,39 @@ void SortUnique(std::vector<TimedPose>& poses) {
               poses.end());
 }
 
+// Refuses what a corrupt or spliced log gives (docs/reliability.md): a
+// stamp earlier than the previous one of the same stream (a clock reset or
+// two logs in one), non-finite or implausible poses.
+void AppendOdometry(const Transform& t, const std::string& where,
+                    std::vector<TimedPose>& poses) {
+  const Rigid3d& p = t.parent_from_child;
+  const auto n = std::to_string(poses.size() + 1);
+  if (!p.translation.allFinite() || !p.rotation.coeffs().allFinite() ||
+      p.translation.norm() >= kMaxOdometryTranslationM) {
+    throw InputError(where, "pose",
+                     "message " + n + " (stamp " + FormatStamp(t.stamp) +
+                         "): not finite or beyond " +
+                         FormatStamp(kMaxOdometryTranslationM) + " m");
+  }
+  if (!poses.empty() && t.stamp < poses.back().timestamp) {
+    throw InputError(where, "header.stamp",
+                     "message " + n + ": stamp " + FormatStamp(t.stamp) +
+                         " is earlier than the previous one " +
+                         FormatStamp(poses.back().timestamp) +
+                         " (stamps must not go backwards)");
+  }
+  poses.push_back({t.stamp, p});
+}
+
 Odometry ReadOdometry(BagMessages& bag, const BagTopics& topics,
                       const RosbagImportOptions& o) {
   Odometry odo;
   if (!o.odom_topic.empty()) {
     topics.Require(o.odom_topic, {kOdometry});
+    const std::string where = bag.Name() + ": topic '" + o.odom_topic + "'";
     bag.ForEachOdometry(o.odom_topic, [&](const Transform& t) {
       odo.child_frame = Frame(t.child);
-      odo.world_from_base.push_back({t.stamp, t.parent_from_child});
+      AppendOdometry(t, where, odo.world_from_base);
       return true;
     });
   } else {
@@ -178,14 +213,16 @@ Odometry ReadOdometry(BagMessages& bag, const BagTopics& topics,
     const size_t colon = o.odom_tf.find(':');
     const std::string parent = Frame(o.odom_tf.substr(0, colon));
     odo.child_frame = Frame(o.odom_tf.substr(colon + 1));
+    const std::string where =
+        bag.Name() + ": topic '" + o.tf_topic + "' (" + o.odom_tf + ")";
     bag.ForEachTransform(o.tf_topic, [&](const Transform& t) {
       if (Frame(t.parent) == parent && Frame(t.child) == odo.child_frame) {
-        odo.world_from_base.push_back({t.stamp, t.parent_from_child});
+        AppendOdometry(t, where, odo.world_from_base);
       }
       return true;
     });
   }
-  SortUnique(odo.world_from_base);
+  DropRepeatedStamps(odo.world_from_base);
   if (odo.world_from_base.size() < 2) {
     throw InputError(
         bag.Name() + ": " +
@@ -245,8 +282,8 @@ cv::Mat RawImagePixels(const std::string& encoding, uint32_t width,
       size < size_t(step) * height) {
     throw InputError(where, "data",
                      "holds " + std::to_string(size) + " bytes, too few for " +
-                         std::to_string(width) + "x" +
-                         std::to_string(height) + " " + encoding);
+                         std::to_string(width) + "x" + std::to_string(height) +
+                         " " + encoding);
   }
   // The message's buffer viewed in place, then copied.
   const cv::Mat view(int(height), int(width), type, const_cast<uint8_t*>(data),
@@ -286,13 +323,10 @@ DecodedImage DecodeRaw(const Image& msg, const std::string& where) {
 DecodedImage DecodeCompressed(const Image& msg, const std::string& where) {
   DecodedImage d;
   d.encoding = "compressed " + msg.encoding;
-  if (!msg.data.empty())
-    d.pixels = cv::imdecode(msg.data, cv::IMREAD_UNCHANGED);
-  if (d.pixels.empty()) {
-    throw InputError(
-        where, "data",
-        "cannot decode the compressed image (format '" + msg.encoding + "')");
-  }
+  // The file reader's checks: whole PNG/JPEG, size limits before decoding.
+  d.pixels = DecodeImageBytes(
+      msg.data, cv::IMREAD_UNCHANGED,
+      where + ": field 'data' (compressed, format '" + msg.encoding + "')");
   const bool png = msg.data.size() > 4 && msg.data[0] == 0x89 &&
                    msg.data[1] == 'P' && msg.data[2] == 'N';
   const bool jpeg =
@@ -316,6 +350,7 @@ struct ImportState {
   fs::path dir;
   std::vector<ImportedFrame> frames;
   RosbagImportReport report;
+  double last_image_stamp = 0;  // of the previous image message
 };
 
 void CheckImageSize(const cv::Mat& pixels, const Camera& camera,
@@ -336,6 +371,15 @@ void ImportImage(const Image& msg, ImportState& s) {
   ++s.report.images_in_bag;
   s.report.image_encoding = image.encoding;
   CheckImageSize(image.pixels, s.camera, where);
+  // Two frames at one instant, or time running back, is a corrupt log.
+  if (s.report.images_in_bag > 1 && msg.stamp <= s.last_image_stamp) {
+    throw InputError(where, "header.stamp",
+                     "image " + std::to_string(s.report.images_in_bag) +
+                         ": stamp " + FormatStamp(msg.stamp) +
+                         " does not increase (previous " +
+                         FormatStamp(s.last_image_stamp) + ")");
+  }
+  s.last_image_stamp = msg.stamp;
   const auto& odo = s.odometry.world_from_base;
   if (msg.stamp < odo.front().timestamp - 1e-9 ||
       msg.stamp > odo.back().timestamp + 1e-9) {
@@ -423,11 +467,15 @@ void ReadAll(BagMessages& bag, ImportState& s) {
     ImportImage(m, s);
     return true;
   });
-  // Bags store messages by receive time; the dataset wants stamp order.
-  std::stable_sort(s.frames.begin(), s.frames.end(),
-                   [](const ImportedFrame& a, const ImportedFrame& b) {
-                     return a.timestamp < b.timestamp;
-                   });
+  if (s.frames.empty()) {
+    throw InputError(
+        s.name + ": topic '" + o.image_topic + "': none of its " +
+        std::to_string(s.report.images_in_bag) +
+        " images lies within the odometry (" +
+        FormatStamp(s.odometry.world_from_base.front().timestamp) + " to " +
+        FormatStamp(s.odometry.world_from_base.back().timestamp) +
+        " s, gaps up to " + FormatStamp(o.max_odometry_gap) + " s)");
+  }
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <csetjmp>
 #include <cstdint>
 #include <cstdio>
@@ -44,6 +45,33 @@ bool PngSize(const std::vector<uint8_t>& data, int64_t* w, int64_t* h) {
   if (data.size() < 24 || BigEndian(data, 12, 4) != 0x49484452) return false;
   *w = BigEndian(data, 16, 4);
   *h = BigEndian(data, 20, 4);
+  return true;
+}
+
+// Width and height from a PNM header (P1..P6): the magic, then width and
+// height as decimal numbers between whitespace and '#' comments.
+bool PnmSize(const std::vector<uint8_t>& data, int64_t* w, int64_t* h) {
+  if (data.size() < 3 || data[0] != 'P' || data[1] < '1' || data[1] > '6') {
+    return false;
+  }
+  size_t i = 2;
+  int64_t v[2] = {0, 0};
+  for (int64_t& x : v) {
+    while (i < data.size() && (std::isspace(data[i]) || data[i] == '#')) {
+      if (data[i] == '#') {
+        while (i < data.size() && data[i] != '\n') ++i;
+      } else {
+        ++i;
+      }
+    }
+    if (i >= data.size() || !std::isdigit(data[i])) return false;
+    // Stops growing far beyond any limit; the size check then refuses it.
+    while (i < data.size() && std::isdigit(data[i]) && x < (int64_t{1} << 40)) {
+      x = 10 * x + (data[i++] - '0');
+    }
+  }
+  *w = v[0];
+  *h = v[1];
   return true;
 }
 
@@ -144,14 +172,18 @@ std::string ImageSizeLimitError(int64_t width, int64_t height) {
 
 cv::Mat ReadImageFile(const std::filesystem::path& path, int flags) {
   const std::string bytes = ReadFileToString(path);
-  const std::vector<uint8_t> data(bytes.begin(), bytes.end());
-  if (data.empty()) throw InputError(path.string() + ": image file is empty");
+  return DecodeImageBytes(std::vector<uint8_t>(bytes.begin(), bytes.end()),
+                          flags, path.string());
+}
+
+cv::Mat DecodeImageBytes(const std::vector<uint8_t>& data, int flags,
+                         const std::string& where) {
+  if (data.empty()) throw InputError(where + ": image file is empty");
   if (StartsWith(data, {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'})) {
     if (data.size() < kPngEnd.size() ||
         !std::equal(kPngEnd.begin(), kPngEnd.end(),
                     data.end() - kPngEnd.size())) {
-      throw InputError(path.string() +
-                       ": truncated PNG (no IEND chunk at the end)");
+      throw InputError(where + ": truncated PNG (no IEND chunk at the end)");
     }
   } else if (StartsWith(data, {0xFF, 0xD8, 0xFF})) {
     const size_t from =
@@ -161,33 +193,37 @@ cv::Mat ReadImageFile(const std::filesystem::path& path, int flags) {
       has_end = data[i - 1] == 0xFF && data[i] == 0xD9;
     }
     if (!has_end) {
-      throw InputError(path.string() +
-                       ": truncated JPEG (no end-of-image marker)");
+      throw InputError(where + ": truncated JPEG (no end-of-image marker)");
     }
   }
   int64_t width = 0, height = 0;
   const bool is_jpeg = JpegSize(data, &width, &height);
-  if (is_jpeg || PngSize(data, &width, &height)) {
-    const std::string error = ImageSizeLimitError(width, height);
-    if (!error.empty()) throw InputError(path.string() + ": image " + error);
+  if (!is_jpeg && !PngSize(data, &width, &height) &&
+      !PnmSize(data, &width, &height)) {
+    // Other formats could claim any size, and OpenCV allocates it before
+    // we could check (the image fuzzer's 47-byte file took 149 MB).
+    throw InputError(where +
+                     ": cannot decode image: not a PNG, JPEG or PNM file with "
+                     "a readable size in its header");
   }
+  const std::string error = ImageSizeLimitError(width, height);
+  if (!error.empty()) throw InputError(where + ": image " + error);
   if (is_jpeg) {
     // An end marker appended to a truncated JPEG passes the check above;
     // libjpeg then only warns and fills the missing part with grey.
     const std::string problem = JpegDecodeProblem(data);
     if (!problem.empty()) {
-      throw InputError(path.string() +
-                       ": JPEG does not decode completely: " + problem);
+      throw InputError(where + ": JPEG does not decode completely: " + problem);
     }
   }
   cv::Mat image;
   try {
     image = cv::imdecode(data, flags);
   } catch (const cv::Exception& e) {  // e.g. OpenCV's own pixel limit
-    throw InputError(path.string() + ": cannot decode image: " + e.err);
+    throw InputError(where + ": cannot decode image: " + e.err);
   }
   if (image.empty()) {
-    throw InputError(path.string() + ": cannot decode image");
+    throw InputError(where + ": cannot decode image");
   }
   return image;
 }

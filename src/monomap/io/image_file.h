@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <opencv2/core.hpp>
 #include <string>
+#include <vector>
 
 namespace monomap {
 
@@ -23,9 +24,14 @@ std::string ImageSizeLimitError(int64_t width, int64_t height);
 // Decodes the image at `path` with cv::imdecode `flags`. Throws InputError
 // naming the file if it is not a regular file or cannot be read, is a PNG
 // without its IEND chunk or a JPEG without its end-of-image marker, claims
-// a size beyond the limits in its header (PNG, JPEG: checked before
-// decoding), or cannot be decoded. Other formats are left to OpenCV (whose
-// own pixel limit is turned into an InputError too).
+// a size beyond the limits in its header (checked before decoding), or
+// cannot be decoded. Only PNG, JPEG and PNM (P1-P6) are read: other formats
+// could make OpenCV allocate an unchecked size.
 cv::Mat ReadImageFile(const std::filesystem::path& path, int flags);
+
+// The same checks and decoding for an image held in memory (e.g. a bag's
+// CompressedImage); `where` names it in errors (a file, or file and topic).
+cv::Mat DecodeImageBytes(const std::vector<uint8_t>& data, int flags,
+                         const std::string& where);
 
 }  // namespace monomap

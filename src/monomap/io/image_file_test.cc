@@ -102,6 +102,42 @@ TEST_F(ImageFileTest, TruncatedFilesAreNamed) {
   EXPECT_NE(Error(text).find("cannot decode"), std::string::npos);
 }
 
+// Found by image_fuzzer (fuzz/corpus/image/other_format_timeout): 47 bytes
+// that OpenCV took for a format other than PNG or JPEG, whose size was not
+// checked; decoding allocated 149 MB and ran over 10 s under ASan. Formats
+// without a size check are refused, PNM's header is read.
+TEST_F(ImageFileTest, FormatsWithoutASizeCheckAreRefused) {
+  const std::vector<uint8_t> finding = {
+      0x2f, 0x50, 0x4e, 0x47, 0x0d, 0x0a, 0x1a, 0x0a, 0x61, 0x45, 0x74, 0x35,
+      0x15, 0xff, 0x43, 0xc4, 0x01, 0x93, 0xce, 0xd2, 0x34, 0xe8, 0x17, 0x53,
+      0x74, 0x35, 0x63, 0x74, 0x79, 0x70, 0x65, 0x49, 0x63, 0x45, 0xcd, 0x00,
+      0x00, 0x00, 0x00, 0x49, 0x45, 0x4e, 0x44, 0xae, 0x42, 0x60, 0x82};
+  std::string e;
+  try {
+    DecodeImageBytes(finding, cv::IMREAD_COLOR, "finding");
+  } catch (const InputError& error) {
+    e = error.what();
+  }
+  EXPECT_NE(e.find("finding: cannot decode image: not a PNG, JPEG or PNM"),
+            std::string::npos)
+      << e;
+  e = Error(Write(".bmp"));
+  EXPECT_NE(e.find("not a PNG, JPEG or PNM"), std::string::npos) << e;
+  // A PNM header claiming 100000 x 100000 (with a comment line).
+  const std::string pgm =
+      "P5\n# big\n100000 100000\n255\n" + std::string(64, 'x');
+  e.clear();
+  try {
+    DecodeImageBytes(std::vector<uint8_t>(pgm.begin(), pgm.end()),
+                     cv::IMREAD_GRAYSCALE, "big.pgm");
+  } catch (const InputError& error) {
+    e = error.what();
+  }
+  EXPECT_NE(e.find("big.pgm: image size 100000x100000 exceeds the limit"),
+            std::string::npos)
+      << e;
+}
+
 // Sizes are checked in the header, before anything is decoded.
 TEST_F(ImageFileTest, HugeHeadersAreRefusedBeforeDecoding) {
   std::vector<uint8_t> png;

@@ -141,6 +141,35 @@ TEST(Rosbag2Import, TruncatedMessageNamesTopicAndField) {
              "of 3072 elements but 100 bytes left");
 }
 
+// Compressed images get the image file checks: a PNG whose header claims
+// 100000 x 100000 is refused before OpenCV allocates it.
+TEST(Rosbag2Import, CompressedImageSizeIsCheckedBeforeDecoding) {
+  const fs::path dir = kDir / "huge";
+  fs::remove_all(dir);
+  BagSpec spec;
+  spec.encoding = "png";
+  {
+    Ros2BagWriter bag(dir);
+    LogDrive(spec, bag);
+    std::vector<uint8_t> png;
+    cv::imencode(".png", TestImage(0, CV_8UC3), png);
+    for (int i = 0; i < 4; ++i) {
+      png[16 + i] = png[20 + i] = static_cast<uint8_t>(100000u >> (24 - 8 * i));
+    }
+    CdrWriter w;
+    w.Header(100.31, "camera_optical");
+    w << std::string("png");
+    w.Bytes(png);
+    bag.Write(ImageTopic(spec), "sensor_msgs/msg/CompressedImage", 100.31,
+              w.Data());
+    bag.Close();
+  }
+  EXPECT_HAS(ImportError(dir, Options(spec)),
+             "huge: topic '/cam/image_raw/compressed': field 'data' "
+             "(compressed, format 'png'): image size 100000x100000 exceeds "
+             "the limit");
+}
+
 TEST(Rosbag2Import, BadEncodingCalibrationAndLensNameTheField) {
   BagSpec spec;
   spec.encoding = "bgra8";

@@ -20,50 +20,15 @@ using namespace bag_test;
 
 // Per process (other checkouts may run the same tests at the same time),
 // removed when the test program ends.
-const fs::path kDir = fs::temp_directory_path() /
-                      ("monomap_rosbag_import_test_" + std::to_string(getpid()));
+const fs::path kDir =
+    fs::temp_directory_path() /
+    ("monomap_rosbag_import_test_" + std::to_string(getpid()));
 struct RemoveAtExit {
   ~RemoveAtExit() {
     std::error_code ec;
     fs::remove_all(kDir, ec);
   }
 } remove_at_exit;
-
-// bag_test::LogDrive into a ROS 1 bag.
-class Ros1Sink {
- public:
-  explicit Ros1Sink(const fs::path& path)
-      : bag_(path.string(), rosbag::bagmode::Write) {}
-  void CameraInfo(const std::string& topic, double t, const Camera& c,
-                  const std::string& model, bool calibrated) {
-    auto info = CameraInfoMsg(c, "camera_optical", t);
-    info.distortion_model = model;
-    if (!calibrated) info.K.fill(0.0);
-    bag_.write(topic, ros::Time(t), info);
-  }
-  void Tf(const std::string& topic, double recorded, double stamp,
-          const std::string& parent, const std::string& child,
-          const Rigid3d& parent_from_child) {
-    bag_.write(topic, ros::Time(recorded),
-               TfMsg(parent_from_child, parent, child, stamp));
-  }
-  void Odometry(const std::string& topic, double t, const std::string& parent,
-                const std::string& child, const Rigid3d& odom_from_base) {
-    bag_.write(topic, ros::Time(t),
-               OdometryMsg(odom_from_base, parent, child, t));
-  }
-  void Image(const std::string& topic, double t, const std::string& frame,
-             const cv::Mat& image, const std::string& encoding) {
-    bag_.write(topic, ros::Time(t), ImageMsg(image, encoding, frame, t));
-  }
-  void Compressed(const std::string& topic, double t, const std::string& frame,
-                  const cv::Mat& image, const std::string& ext) {
-    bag_.write(topic, ros::Time(t), CompressedMsg(image, ext, frame, t));
-  }
-
- private:
-  rosbag::Bag bag_;
-};
 
 fs::path WriteBag(const std::string& name, const BagSpec& spec) {
   fs::create_directories(kDir);

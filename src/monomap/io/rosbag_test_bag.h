@@ -1,5 +1,6 @@
 // Test helper: builds ROS 1 messages for bags that tests write with
-// rosbag::Bag (the importer's tests generate their own bags).
+// rosbag::Bag (the importer's tests generate their own bags), and the sink
+// of bag_test::LogDrive that writes them.
 #pragma once
 
 #include <geometry_msgs/TransformStamped.h>
@@ -10,6 +11,7 @@
 #include <sensor_msgs/Image.h>
 #include <tf2_msgs/TFMessage.h>
 
+#include <filesystem>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <string>
@@ -107,5 +109,41 @@ inline tf2_msgs::TFMessage TfMsg(const Rigid3d& parent_from_child,
   m.transforms.push_back(t);
   return m;
 }
+
+// bag_test::LogDrive into a ROS 1 bag.
+class Ros1Sink {
+ public:
+  explicit Ros1Sink(const std::filesystem::path& path)
+      : bag_(path.string(), rosbag::bagmode::Write) {}
+  void CameraInfo(const std::string& topic, double t, const Camera& c,
+                  const std::string& model, bool calibrated) {
+    auto info = CameraInfoMsg(c, "camera_optical", t);
+    info.distortion_model = model;
+    if (!calibrated) info.K.fill(0.0);
+    bag_.write(topic, ros::Time(t), info);
+  }
+  void Tf(const std::string& topic, double recorded, double stamp,
+          const std::string& parent, const std::string& child,
+          const Rigid3d& parent_from_child) {
+    bag_.write(topic, ros::Time(recorded),
+               TfMsg(parent_from_child, parent, child, stamp));
+  }
+  void Odometry(const std::string& topic, double t, const std::string& parent,
+                const std::string& child, const Rigid3d& odom_from_base) {
+    bag_.write(topic, ros::Time(t),
+               OdometryMsg(odom_from_base, parent, child, t));
+  }
+  void Image(const std::string& topic, double t, const std::string& frame,
+             const cv::Mat& image, const std::string& encoding) {
+    bag_.write(topic, ros::Time(t), ImageMsg(image, encoding, frame, t));
+  }
+  void Compressed(const std::string& topic, double t, const std::string& frame,
+                  const cv::Mat& image, const std::string& ext) {
+    bag_.write(topic, ros::Time(t), CompressedMsg(image, ext, frame, t));
+  }
+
+ private:
+  rosbag::Bag bag_;
+};
 
 }  // namespace monomap::rosbag_test

@@ -9,6 +9,7 @@
 #include "monomap/io/camera_mount.h"
 #include "monomap/io/dataset.h"
 #include "monomap/io/dataset_writer.h"
+#include "monomap/io/image_file.h"
 #include "monomap/io/trajectory_io.h"
 #include "monomap/util/angles.h"
 #include "monomap/util/error.h"
@@ -92,10 +93,6 @@ std::vector<TumImage> ReadTumRgbList(const fs::path& list) {
       throw InputError(list.string(), line.number,
                        "expected 'timestamp filename'");
     }
-    if (!images.empty() && im.timestamp <= images.back().timestamp) {
-      throw InputError(list.string(), line.number,
-                       "timestamp " + tokens[0] + " does not increase");
-    }
     im.path = tokens[1];
     images.push_back(im);
   }
@@ -104,10 +101,8 @@ std::vector<TumImage> ReadTumRgbList(const fs::path& list) {
 }
 
 Camera CameraFor(const TumImportOptions& o, const fs::path& first_image) {
-  const cv::Mat image = cv::imread(first_image.string(), cv::IMREAD_UNCHANGED);
-  if (image.empty()) {
-    throw InputError(first_image.string() + ": cannot read the image");
-  }
+  // The camera size comes from the first image: read it with the limits.
+  const cv::Mat image = ReadImageFile(first_image, cv::IMREAD_UNCHANGED);
   Camera c;
   if (!o.preset.empty()) {
     c = TumPresetCamera(o.preset);
@@ -171,6 +166,19 @@ struct PosedImages {
   std::string out_prefix;              // where images go in the dataset
 };
 
+// Frames out of order, or two at one time, mean a corrupt or spliced list.
+void CheckTimesIncrease(const PosedImages& in) {
+  for (size_t k = 1; k < in.images.size(); ++k) {
+    if (in.images[k].timestamp <= in.images[k - 1].timestamp) {
+      char text[160];
+      std::snprintf(text, sizeof(text),
+                    "timestamp %.9f does not increase (previous %.9f)",
+                    in.images[k].timestamp, in.images[k - 1].timestamp);
+      throw InputError(in.list.string(), in.images[k].line, text);
+    }
+  }
+}
+
 // Interpolates a pose for every image (dropping those without one), links
 // the images, simulates odometry if `simulate`, and writes the dataset.
 ImportReport ImportPosedImages(const PosedImages& in, const Camera& camera,
@@ -181,6 +189,7 @@ ImportReport ImportPosedImages(const PosedImages& in, const Camera& camera,
   report.images_listed = static_cast<int>(in.images.size());
   report.odometry_simulated = simulate;
   report.camera = camera;
+  CheckTimesIncrease(in);
   AtomicDirectory out(out_dir, "dataset");
   std::vector<ImportedFrame> frames;
   std::vector<Rigid3d> poses;
@@ -342,7 +351,13 @@ std::vector<TimedPose> ReadEurocGroundTruth(const fs::path& path,
                          "value '" + row.fields[i + 1] + "' is not a number");
       }
     }
-    const Rigid3d world_from_body(Eigen::Quaterniond(v[3], v[4], v[5], v[6]),
+    const Eigen::Quaterniond q(v[3], v[4], v[5], v[6]);
+    if (std::abs(q.norm() - 1.0) > 1e-2) {
+      throw InputError(path.string(), row.line,
+                       "quaternion is not unit length (norm " +
+                           std::to_string(q.norm()) + ")");
+    }
+    const Rigid3d world_from_body(q.normalized(),
                                   Eigen::Vector3d(v[0], v[1], v[2]));
     const double t = NanosecondsToSeconds(row, path);
     if (!poses.empty() && t <= poses.back().timestamp) {
@@ -369,6 +384,16 @@ ImportReport ImportEuroc(const fs::path& dir, const fs::path& out_dir,
   for (const CsvRow& row : ReadCsv(in.list, 2)) {
     in.images.push_back(
         {NanosecondsToSeconds(row, in.list), row.fields[1], row.line});
+  }
+  // sensor.yaml's resolution must be the images' (the dataset keeps it).
+  const fs::path first = in.root / in.images.front().path;
+  const cv::Mat image = ReadImageFile(first, cv::IMREAD_UNCHANGED);
+  if (image.cols != camera.width || image.rows != camera.height) {
+    throw InputError((cam / "sensor.yaml").string(), "resolution",
+                     std::to_string(camera.width) + "x" +
+                         std::to_string(camera.height) + " but " +
+                         first.string() + " is " + std::to_string(image.cols) +
+                         "x" + std::to_string(image.rows));
   }
   const fs::path gt_path = mav / "state_groundtruth_estimate0" / "data.csv";
   if (fs::exists(gt_path)) {
@@ -439,6 +464,12 @@ std::vector<TimedPose> ReadKittiPoses(const fs::path& path,
   std::vector<TimedPose> poses;
   for (size_t i = 0; i < lines.size(); ++i) {
     const auto m = KittiMatrix(lines[i], path, false);
+    const Eigen::Matrix3d r = m.leftCols<3>();
+    if (!((r.transpose() * r - Eigen::Matrix3d::Identity()).norm() < 1e-3 &&
+          r.determinant() > 0)) {
+      throw InputError(path.string(), lines[i].number,
+                       "the 3x3 part is not a rotation matrix");
+    }
     const Rigid3d world_from_cam0(
         Eigen::Quaterniond(Eigen::Matrix3d(m.leftCols<3>())), m.col(3));
     poses.push_back({in.images[i].timestamp, world_from_cam0 * cam0_from_cam});
@@ -482,11 +513,7 @@ ImportReport ImportKitti(const fs::path& seq, const fs::path& out_dir,
   in.trajectory =
       o.odometry.empty() ? in.groundtruth : ReadTumTrajectory(o.odometry);
   const cv::Mat first =
-      cv::imread((seq / in.images.front().path).string(), cv::IMREAD_UNCHANGED);
-  if (first.empty()) {
-    throw InputError((seq / in.images.front().path).string() +
-                     ": cannot read the image");
-  }
+      ReadImageFile(seq / in.images.front().path, cv::IMREAD_UNCHANGED);
   camera.width = first.cols;
   camera.height = first.rows;
   return ImportPosedImages(in, camera, out_dir, o.odometry.empty(), o.simulated,

@@ -1,14 +1,14 @@
 #include "monomap/io/standard_import.h"
 
-#include <unistd.h>
-
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
 #include <sstream>
 
 #include "monomap/io/dataset.h"
+#include "monomap/io/standard_import_test_data.h"
 #include "monomap/io/trajectory_io.h"
 #include "monomap/util/error.h"
 #include "monomap/util/file.h"
@@ -16,54 +16,19 @@
 namespace monomap {
 namespace {
 namespace fs = std::filesystem;
+using namespace standard_test;
 
 // Per process (other checkouts may run the same tests at the same time),
 // removed when the test program ends.
-const fs::path kDir = fs::temp_directory_path() /
-                      ("monomap_standard_import_test_" + std::to_string(getpid()));
+const fs::path kDir =
+    fs::temp_directory_path() /
+    ("monomap_standard_import_test_" + std::to_string(getpid()));
 struct RemoveAtExit {
   ~RemoveAtExit() {
     std::error_code ec;
     fs::remove_all(kDir, ec);
   }
 } remove_at_exit;
-
-// A hand-held camera path: moving forward and sideways, turning slowly.
-Rigid3d TruePose(double t) {
-  const double s = t - 1000.0;
-  return Rigid3d(
-      YawRotation(0.2 * s) * Eigen::Quaterniond(Eigen::AngleAxisd(
-                                 0.05 * std::sin(s), Eigen::Vector3d::UnitX())),
-      Eigen::Vector3d(0.3 * s, 0.1 * std::sin(2 * s), 1.5));
-}
-
-// A TUM sequence as distributed: ground truth at 100 Hz over [1000, 1004]
-// s, images at 30 Hz from 999.8 s (the first 6 before the ground truth).
-fs::path WriteTumSequence(int width, bool with_groundtruth) {
-  const fs::path dir = kDir / "rgbd_dataset_freiburg1_test";
-  fs::remove_all(dir);
-  fs::create_directories(dir / "rgb");
-  std::string rgb =
-      "# color images\n# file: 'rgbd_dataset_freiburg1_test.bag'"
-      "\n# timestamp filename\n";
-  for (int k = 0; k < 60; ++k) {
-    char stamp[64];
-    std::snprintf(stamp, sizeof(stamp), "%.6f", 999.8 + k / 30.0);
-    const std::string name = "rgb/" + std::string(stamp) + ".png";
-    cv::Mat image(width * 3 / 4, width, CV_8UC3, cv::Scalar(k, 2 * k, 100));
-    cv::imwrite((dir / name).string(), image);
-    rgb += std::string(stamp) + " " + name + "\n";
-  }
-  WriteFileAtomic(dir / "rgb.txt", rgb);
-  if (with_groundtruth) {
-    std::vector<TimedPose> gt;
-    for (int i = 0; i <= 400; ++i) {
-      gt.push_back({1000.0 + i / 100.0, TruePose(1000.0 + i / 100.0)});
-    }
-    WriteTumTrajectory(dir / "groundtruth.txt", gt, "ground truth trajectory");
-  }
-  return dir;
-}
 
 TumImportOptions ExactOdometry() {
   TumImportOptions o;
@@ -75,7 +40,7 @@ TumImportOptions ExactOdometry() {
 }
 
 TEST(TumImport, PresetAndExactOdometryGiveTheGroundTruth) {
-  const fs::path tum = WriteTumSequence(640, true);
+  const fs::path tum = WriteTumSequence(kDir, 640, true);
   const ImportReport r = ImportTum(tum, kDir / "out", ExactOdometry());
   EXPECT_EQ(r.images_listed, 60);
   EXPECT_EQ(r.dropped, 6);  // 999.8 .. 999.9667 s, before the ground truth
@@ -106,7 +71,7 @@ TEST(TumImport, PresetAndExactOdometryGiveTheGroundTruth) {
 }
 
 TEST(TumImport, SimulatedOdometryHasTheChosenScaleAndSeededDrift) {
-  const fs::path tum = WriteTumSequence(640, true);
+  const fs::path tum = WriteTumSequence(kDir, 640, true);
   TumImportOptions o = ExactOdometry();
   o.simulated.scale_error = 0.05;
   ImportTum(tum, kDir / "scaled", o);
@@ -149,7 +114,7 @@ std::string ImportError(const fs::path& tum, const TumImportOptions& o) {
 }
 
 TEST(TumImport, ErrorsNameTheFileOrOption) {
-  fs::path tum = WriteTumSequence(320, true);
+  fs::path tum = WriteTumSequence(kDir, 320, true);
   std::string e = ImportError(tum, ExactOdometry());
   EXPECT_NE(e.find("999.800000.png: image is 320x240 but preset fr1 is for "
                    "640x480"),
@@ -167,68 +132,13 @@ TEST(TumImport, ErrorsNameTheFileOrOption) {
   o.intrinsics.clear();
   e = ImportError(tum, o);
   EXPECT_NE(e.find("'fr4' is not a TUM camera"), std::string::npos) << e;
-  tum = WriteTumSequence(640, false);
+  tum = WriteTumSequence(kDir, 640, false);
   e = ImportError(tum, ExactOdometry());
   EXPECT_NE(e.find("groundtruth.txt: not found"), std::string::npos) << e;
 }
 
-// An EuRoC ASL sequence: cam0 at 20 Hz over [1.0, 3.0] s, body ground
-// truth at 200 Hz over [1.2, 2.9] s, the camera turned and offset from the
-// body (T_BS).
-Rigid3d BodyFromCam() {
-  Eigen::Matrix3d r;
-  r << 0, -1, 0, 1, 0, 0, 0, 0, 1;
-  return Rigid3d(
-      Eigen::Quaterniond(r) * Eigen::Quaterniond(Eigen::AngleAxisd(
-                                  0.1, Eigen::Vector3d(1, 1, 0).normalized())),
-      Eigen::Vector3d(-0.02, 0.06, 0.01));
-}
-
-fs::path WriteEurocSequence(const std::string& distortion_model) {
-  const fs::path dir = kDir / "MH_test";
-  const fs::path cam = dir / "mav0" / "cam0";
-  fs::remove_all(dir);
-  fs::create_directories(cam / "data");
-  fs::create_directories(dir / "mav0" / "state_groundtruth_estimate0");
-  std::string csv = "#timestamp [ns],filename\n";
-  for (int k = 0; k <= 40; ++k) {
-    const long long ns = 1000000000LL + k * 50000000LL;
-    const std::string name = std::to_string(ns) + ".png";
-    cv::imwrite((cam / "data" / name).string(),
-                cv::Mat(60, 80, CV_8UC1, cv::Scalar(3 * k)));
-    csv += std::to_string(ns) + "," + name + "\n";
-  }
-  WriteFileAtomic(cam / "data.csv", csv);
-  const Eigen::Matrix4d t = BodyFromCam().ToMatrix4();
-  std::ostringstream yaml;
-  yaml.precision(17);
-  yaml << "%YAML:1.0\nsensor_type: camera\ncomment: test\nT_BS:\n  cols: 4\n"
-       << "  rows: 4\n  data: [";
-  for (int i = 0; i < 16; ++i) yaml << (i ? ", " : "") << t(i / 4, i % 4);
-  yaml << "]\nrate_hz: 20\nresolution: [80, 60]\ncamera_model: pinhole\n"
-       << "intrinsics: [70.5, 70.1, 39.2, 29.9] #fu, fv, cu, cv\n"
-       << "distortion_model: " << distortion_model << "\n"
-       << "distortion_coefficients: [-0.28, 0.07, 0.0002, 1.7e-05]\n";
-  WriteFileAtomic(cam / "sensor.yaml", yaml.str());
-  std::ostringstream gt;
-  gt.precision(17);
-  gt << "#timestamp, p_RS_R_x [m], p_RS_R_y [m], p_RS_R_z [m], q_RS_w [], "
-        "q_RS_x [], q_RS_y [], q_RS_z [], v_RS_R_x [m s^-1], ...\n";
-  for (int i = 240; i <= 580; ++i) {  // 1.2 .. 2.9 s
-    const Rigid3d body = TruePose(1000.0 + i * 0.005);
-    const auto& q = body.rotation;
-    gt << 5000000LL * i << "," << body.translation.x() << ","
-       << body.translation.y() << "," << body.translation.z() << "," << q.w()
-       << "," << q.x() << "," << q.y() << "," << q.z()
-       << ",0,0,0,0,0,0,0,0,0\n";
-  }
-  WriteFileAtomic(dir / "mav0" / "state_groundtruth_estimate0" / "data.csv",
-                  gt.str());
-  return dir;
-}
-
 TEST(EurocImport, CameraGroundTruthIsBodyTimesTbs) {
-  const fs::path seq = WriteEurocSequence("radial-tangential");
+  const fs::path seq = WriteEurocSequence(kDir, "radial-tangential");
   EurocImportOptions o;
   o.simulated = ExactOdometry().simulated;
   const ImportReport r = ImportEuroc(seq, kDir / "euroc", o);
@@ -254,7 +164,7 @@ TEST(EurocImport, CameraGroundTruthIsBodyTimesTbs) {
 }
 
 TEST(EurocImport, EquidistantLensIsKept) {
-  const fs::path seq = WriteEurocSequence("equidistant");
+  const fs::path seq = WriteEurocSequence(kDir, "equidistant");
   ImportEuroc(seq, kDir / "euroc_fisheye", EurocImportOptions());
   const Dataset ds = LoadDataset(kDir / "euroc_fisheye");
   EXPECT_EQ(ds.camera.model, LensModel::kEquidistant);
@@ -263,7 +173,7 @@ TEST(EurocImport, EquidistantLensIsKept) {
 }
 
 TEST(EurocImport, ErrorsNameTheField) {
-  const fs::path seq = WriteEurocSequence("fov");
+  const fs::path seq = WriteEurocSequence(kDir, "fov");
   std::string e;
   try {
     ImportEuroc(seq, kDir / "euroc_failed", EurocImportOptions());
@@ -285,44 +195,8 @@ TEST(EurocImport, ErrorsNameTheField) {
   EXPECT_NE(e.find("sensor.yaml"), std::string::npos) << e;
 }
 
-// A KITTI odometry sequence: 20 frames at 10 Hz, rectified cameras 0 and 2
-// with a 0.54 m baseline (P2 = K [I | t]), poses of camera 0.
-fs::path WriteKittiSequence() {
-  const fs::path seq = kDir / "dataset" / "sequences" / "07";
-  fs::remove_all(kDir / "dataset");
-  fs::create_directories(seq / "image_0");
-  fs::create_directories(seq / "image_2");
-  fs::create_directories(kDir / "dataset" / "poses");
-  WriteFileAtomic(seq / "calib.txt",
-                  "P0: 70 0 40 0 0 70 30 0 0 0 1 0\n"
-                  "P1: 70 0 40 -37.8 0 70 30 0 0 0 1 0\n"
-                  "P2: 70 0 40 4.2 0 70 30 0.14 0 0 1 0.003\n"
-                  "P3: 70 0 40 -33.6 0 70 30 0.14 0 0 1 0.003\n"
-                  "Tr: 1 0 0 0 0 1 0 0 0 0 1 0\n");
-  std::string times, poses;
-  for (int k = 0; k < 20; ++k) {
-    char line[512];
-    std::snprintf(line, sizeof(line), "%e\n", 0.1 * k);
-    times += line;
-    const Eigen::Matrix4d m = TruePose(1000.0 + 0.1 * k).ToMatrix4();
-    std::ostringstream row;
-    row.precision(17);
-    for (int i = 0; i < 12; ++i) row << (i ? " " : "") << m(i / 4, i % 4);
-    poses += row.str() + "\n";
-    char name[32];
-    std::snprintf(name, sizeof(name), "%06d.png", k);
-    for (const char* folder : {"image_0", "image_2"}) {
-      cv::imwrite((seq / folder / name).string(),
-                  cv::Mat(60, 80, CV_8UC1, cv::Scalar(5 * k)));
-    }
-  }
-  WriteFileAtomic(seq / "times.txt", times);
-  WriteFileAtomic(kDir / "dataset" / "poses" / "07.txt", poses);
-  return seq;
-}
-
 TEST(KittiImport, PosesOfCameraZeroAndTwo) {
-  const fs::path seq = WriteKittiSequence();
+  const fs::path seq = WriteKittiSequence(kDir);
   KittiImportOptions o;
   o.simulated = ExactOdometry().simulated;
   for (int camera : {0, 2}) {
@@ -355,7 +229,7 @@ TEST(KittiImport, PosesOfCameraZeroAndTwo) {
 }
 
 TEST(KittiImport, MismatchedPosesNameTheFiles) {
-  const fs::path seq = WriteKittiSequence();
+  const fs::path seq = WriteKittiSequence(kDir);
   WriteFileAtomic(seq / "times.txt",
                   ReadFileToString(seq / "times.txt") + "2.000000e+00\n");
   std::string e;
