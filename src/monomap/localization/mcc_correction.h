@@ -47,11 +47,9 @@ struct MccCorrectionOptions {
     // The estimate is near the truth already; a deeper pyramid lets
     // tracks at the map's silhouette run off (see MccOptions::klt_levels).
     o.klt_levels = 2;
-    // Stop after a round that moved the inliers < 0.5 px: the second round
-    // would repeat it. Saves a third of a desk update (most of the time to
-    // keep up at 30 frames/s on one core); accuracy held over the desk and
-    // the simulated sweeps (docs/benchmarks.md, "Speed per update").
-    o.converged_px = 0.5;
+    // converged_px 0.5 (stop after a round that moved < 0.5 px) saves a
+    // third of a desk update but moves the desk's errors (+0.1 mm,
+    // -0.005 deg; docs/benchmarks.md, "Speed per update"): opt-in.
     return o;
   }();
   // Particles closer than this after resampling are merged (m, deg).
