@@ -90,6 +90,10 @@ struct SweepOptions {
   // MCC: the refinement stops after a round that moved less than this (px;
   // negative: the localizer's default).
   double refine_converged_px = -1.0;
+  // Also run every MCC configuration with the refinement stopping at this
+  // (px; negative: not), as a twin named <config>_conv on the same maps
+  // and traversals: a default is compared at half the cost of two sweeps.
+  double twin_refine_converged_px = -1.0;
   // MCC: least random particles injected per resampling (-1: the
   // localizer's default).
   int mcc_min_injected = -1;
@@ -120,6 +124,8 @@ struct Config {
   std::string name;
   LocalizationMethod method;
   int particles;
+  // Overrides SweepOptions::refine_converged_px if >= 0.
+  double refine_converged_px = -1.0;
 };
 
 struct ConfigRun {
@@ -330,9 +336,10 @@ nlohmann::json RunSeed(const SweepOptions& o, const std::string& world,
     if (o.sigma > 0) lo.mcl.measurement.sigma = o.sigma;
     if (o.refine_width == 0) lo.mcc.refine_estimate = false;
     if (o.refine_width > 0) lo.mcc.refinement.width = o.refine_width;
-    if (o.refine_converged_px >= 0) {
-      lo.mcc.refinement.converged_px = o.refine_converged_px;
-    }
+    const double converged_px = configs[c].refine_converged_px >= 0
+                                    ? configs[c].refine_converged_px
+                                    : o.refine_converged_px;
+    if (converged_px >= 0) lo.mcc.refinement.converged_px = converged_px;
     if (o.mcc_min_injected >= 0) {
       lo.recovery.mcc_min_injected = o.mcc_min_injected;
     }
@@ -577,6 +584,19 @@ nlohmann::json Summarize(const SweepOptions& o, const std::string& world,
   return summary;
 }
 
+// The twins of the MCC configurations (twin_refine_converged_px).
+void AddTwins(const SweepOptions& o, std::vector<Config>* configs) {
+  if (o.twin_refine_converged_px < 0) return;
+  const size_t n = configs->size();
+  for (size_t c = 0; c < n; ++c) {
+    if ((*configs)[c].method != LocalizationMethod::kMcc) continue;
+    Config twin = (*configs)[c];
+    twin.name += "_conv";
+    twin.refine_converged_px = o.twin_refine_converged_px;
+    configs->push_back(twin);
+  }
+}
+
 int Run(const SweepOptions& o) {
   o.accuracy.Check();
   CheckOption(o.seeds >= 1, "seeds", "must be >= 1");
@@ -596,6 +616,7 @@ int Run(const SweepOptions& o) {
     });
     CheckOption(!configs.empty(), "configs", "names none of mcl_N, mcc_N");
   }
+  AddTwins(o, &configs);
   const fs::path root =
       o.keep_dir.empty()
           ? fs::temp_directory_path() /
@@ -622,6 +643,7 @@ int Run(const SweepOptions& o) {
       {"sigma", o.sigma},
       {"refine_width", o.refine_width},
       {"refine_converged_px", o.refine_converged_px},
+      {"twin_refine_converged_px", o.twin_refine_converged_px},
       {"mcc_max_rotation_deg", o.mcc_max_rotation_deg},
       {"relocalize_ncc_drop", o.relocalize_ncc_drop},
       {"relocalize_fraction", o.relocalize_fraction},
@@ -702,6 +724,9 @@ int main(int argc, char** argv) {
   app.add_option("--refine-converged-px", o.refine_converged_px,
                  "MCC: the refinement stops after a round that moved less "
                  "than this (px; negative: the localizer's default)");
+  app.add_option("--twin-refine-converged-px", o.twin_refine_converged_px,
+                 "Also run each MCC configuration with the refinement "
+                 "stopping at this (px), as <config>_conv (negative: not)");
   app.add_option("--mcc-min-injected", o.mcc_min_injected,
                  "MCC: least random particles injected per resampling "
                  "(-1: the localizer's default)");

@@ -46,7 +46,7 @@ if [ -d "$DESK" ] && [ ! -f "$OUT/deskmap/map.json" ]; then
     --frames 150 -q
 fi
 
-# Compares two reports without their wall-clock times. Keys, counts and
+# Compares two reports without their wall-clock and CPU times. Keys, counts and
 # flags must be equal; numbers equal or within 1e-12 relative (the rotation
 # errors come from eval/localization_accuracy, which converts radians to
 # degrees as x * (180 / pi) where the old localizer used x / (pi / 180): a
@@ -55,7 +55,8 @@ fi
 same_report() {
   python3 - "$1" "$2" <<'PY'
 import json, math, sys
-timing = {"seconds", "mean_step_seconds", "weigh_seconds", "mcc_seconds"}
+timing = {"seconds", "mean_step_seconds", "weigh_seconds", "mcc_seconds",
+          "cpu_seconds"}
 def strip(v):
     if isinstance(v, dict):
         return {k: strip(x) for k, x in v.items() if k not in timing}

@@ -5,14 +5,13 @@
 #include <ctime>
 #include <limits>
 
+#include "monomap/util/angles.h"
 #include "monomap/util/error.h"
 #include "monomap/util/progress.h"
 
 namespace monomap {
 
 namespace {
-
-constexpr double kDegToRad = M_PI / 180.0;
 
 // CPU seconds used by the process so far (all threads).
 double ProcessCpuSeconds() {
@@ -177,12 +176,12 @@ void Localizer::InitializeAtPose(const Rigid3d& world_from_cam) {
                    options_.init.spread_deg);
 }
 
-void Localizer::InitializeAtPose(const Rigid3d& world_from_cam,
-                                 double spread_m, double spread_deg) {
+void Localizer::InitializeAtPose(const Rigid3d& world_from_cam, double spread_m,
+                                 double spread_deg) {
   // Injection in 6-DoF keeps the height and tilt of this pose.
   if (!reference_) reference_ = world_from_cam;
   particles_ = state_->AroundPose(world_from_cam, options_.mcl.num_particles,
-                                  spread_m, spread_deg * kDegToRad, &rng_);
+                                  spread_m, DegToRad(spread_deg), &rng_);
   first_step_ = true;
   recovery_.Reset();
 }
@@ -281,7 +280,7 @@ LocalizerEstimate Localizer::Estimate(const LiveFrame& live,
   // FromPose puts it back exactly on the state's manifold.
   Particle mean = state_->FromPose(BestClusterMean(
       particles_, weights, options_.mcl.cluster_radius_m,
-      options_.mcl.cluster_angle_deg * kDegToRad, &stats->cluster_weight));
+      DegToRad(options_.mcl.cluster_angle_deg), &stats->cluster_weight));
   if (correction_) {
     const Timer refine_timer;
     stats->refined = correction_->RefineEstimate(live, *state_, &mean);

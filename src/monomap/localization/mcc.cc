@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "monomap/tracking/pyramidal_lk.h"
+#include "monomap/util/angles.h"
 #include "monomap/util/error.h"
 
 namespace monomap {
@@ -61,7 +62,8 @@ MonteCarloCorrector::MonteCarloCorrector(const Renderer* renderer,
 namespace {
 
 cv::Mat CvFromRigid(const Rigid3d& cam_from_world, cv::Mat* tvec) {
-  const Eigen::Vector3d w = RotationVectorFromQuaternion(cam_from_world.rotation);
+  const Eigen::Vector3d w =
+      RotationVectorFromQuaternion(cam_from_world.rotation);
   cv::Mat rvec = (cv::Mat_<double>(3, 1) << w.x(), w.y(), w.z());
   *tvec = (cv::Mat_<double>(3, 1) << cam_from_world.translation.x(),
            cam_from_world.translation.y(), cam_from_world.translation.z());
@@ -95,6 +97,53 @@ struct Matches {
   std::vector<cv::Point2d> image;
 };
 
+// The bounding box of the mask grown by 3 px (within the image); empty
+// without any masked pixel. The map often covers half of the view, and
+// the work on masked pixels is done in this box only, with the same
+// result as over the whole image: see DetectCorners.
+cv::Rect MaskBox(const cv::Mat& mask) {
+  constexpr int kMargin = 3;
+  const cv::Rect box = cv::boundingRect(mask);
+  if (box.empty()) return box;
+  return (box + cv::Size(2 * kMargin, 2 * kMargin) -
+          cv::Point(kMargin, kMargin)) &
+         cv::Rect(0, 0, mask.cols, mask.rows);
+}
+
+// Shi-Tomasi corners of `render` where `mask` is set, searched in `box`
+// (MaskBox). Equal to a search of the whole image: the corner response
+// reads the pixels around the box, its 3x3 sums and the local-maximum
+// test reach 2 px from a masked pixel, and goodFeaturesToTrack orders
+// equal responses row-major in either image.
+void DetectCorners(const cv::Mat& render, const cv::Mat& mask,
+                   const cv::Rect& box, const MccOptions& o,
+                   std::vector<cv::Point2f>* corners) {
+  corners->clear();
+  if (box.empty()) return;
+  cv::goodFeaturesToTrack(render(box), *corners, o.max_corners,
+                          o.corner_quality, o.min_corner_distance_px,
+                          mask(box));
+  const cv::Point2f offset(static_cast<float>(box.x),
+                           static_cast<float>(box.y));
+  for (cv::Point2f& c : *corners) c += offset;
+}
+
+// KLT assumes brightness constancy: the live image brought to the
+// render's gain and offset (mean and spread over the map pixels, all in
+// `box`), else exposure changes bias the tracks by tenths of a pixel.
+cv::Mat MatchGain(const cv::Mat& render, const cv::Mat& live_raw,
+                  const cv::Mat& mask, const cv::Rect& box) {
+  if (box.empty()) return live_raw;
+  cv::Scalar mr, sr, ml, sl;
+  cv::meanStdDev(render(box), mr, sr, mask(box));
+  cv::meanStdDev(live_raw(box), ml, sl, mask(box));
+  if (!(sl[0] > 1.0 && sr[0] > 1.0)) return live_raw;
+  const double gain = sr[0] / sl[0];
+  cv::Mat live;
+  live_raw.convertTo(live, CV_8U, gain, mr[0] - gain * ml[0]);
+  return live;
+}
+
 RenderedView RenderView(const Renderer& renderer, const Camera& camera,
                         const MccOptions& o, const PyrLkOptions& lk,
                         const cv::Mat& live_raw, const Rigid3d& start) {
@@ -108,73 +157,74 @@ RenderedView RenderView(const Renderer& renderer, const Camera& camera,
                   cv::MORPH_RECT,
                   cv::Size(2 * o.border_px + 1, 2 * o.border_px + 1)));
   }
+  const cv::Rect box = MaskBox(mask);
   // Corner detection on the render runs beside the preparation of the two
   // images for KLT (the full-size refinement is one correction at a time,
   // and these steps are most of its time).
   tbb::parallel_invoke(
+      [&] { DetectCorners(v.render, mask, box, o, &v.corners); },
       [&] {
-        cv::goodFeaturesToTrack(v.render, v.corners, o.max_corners,
-                                o.corner_quality, o.min_corner_distance_px,
-                                mask);
-      },
-      [&] {
-        // KLT assumes brightness constancy: bring the live image to the
-        // render's gain and offset (mean and spread over the map pixels),
-        // else exposure changes bias the tracks by tenths of a pixel.
-        cv::Scalar mr, sr, ml, sl;
-        cv::meanStdDev(v.render, mr, sr, mask);
-        cv::meanStdDev(live_raw, ml, sl, mask);
-        cv::Mat live;
-        if (sl[0] > 1.0 && sr[0] > 1.0) {
-          const double gain = sr[0] / sl[0];
-          live_raw.convertTo(live, CV_8U, gain, mr[0] - gain * ml[0]);
-        } else {
-          live = live_raw;
-        }
         BuildLkPyramid(v.render, lk, &v.render_pyramid);
-        BuildLkPyramid(live, lk, &v.live_pyramid);
+        BuildLkPyramid(MatchGain(v.render, live_raw, mask, box), lk,
+                       &v.live_pyramid);
       });
   return v;
 }
 
+// Depth of the render at a corner (0: none or outside).
+float DepthAt(const cv::Mat& depth, const cv::Point2f& corner) {
+  const int u = cvRound(corner.x), w = cvRound(corner.y);
+  if (u < 0 || w < 0 || u >= depth.cols || w >= depth.rows) return 0.0f;
+  return depth.at<float>(w, u);
+}
+
 // Tracks the corners into the live image and back; those that return
-// within max_forward_backward_px and have depth become matches.
+// within max_forward_backward_px and have depth become matches. Only the
+// corners tracked forward, with depth, are tracked back (the points are
+// tracked independently, so the others would be dropped anyway).
 Matches TrackCorners(const RenderedView& v, const Camera& c,
                      const MccOptions& o, PyrLkOptions lk,
                      const Rigid3d& start) {
   const std::vector<cv::Point2f>& corners = v.corners;
-  std::vector<cv::Point2f> fwd, back;
+  std::vector<cv::Point2f> fwd, fwd_kept, back;
   std::vector<uchar> st_f, st_b;
-  std::vector<float> err;
-  PyramidalLk(v.render_pyramid, v.live_pyramid, corners, &fwd, &st_f, &err,
-              lk);
-  back = corners;  // backward starts at the original corner positions
-  lk.use_initial_guess = true;
-  PyramidalLk(v.live_pyramid, v.render_pyramid, fwd, &back, &st_b, &err, lk);
-  Matches m;
+  std::vector<float> err, depth;
+  std::vector<size_t> kept;
+  PyramidalLk(v.render_pyramid, v.live_pyramid, corners, &fwd, &st_f, &err, lk);
   for (size_t i = 0; i < corners.size(); ++i) {
-    if (!st_f[i] || !st_b[i]) continue;
-    const cv::Point2f d = back[i] - corners[i];
-    if (d.dot(d) > o.max_forward_backward_px * o.max_forward_backward_px)
+    const float z = DepthAt(v.depth, corners[i]);
+    if (!st_f[i] || !(z > 0.0f)) continue;
+    kept.push_back(i);
+    depth.push_back(z);
+    fwd_kept.push_back(fwd[i]);
+    back.push_back(corners[i]);  // backward starts at the corner
+  }
+  lk.use_initial_guess = true;
+  PyramidalLk(v.live_pyramid, v.render_pyramid, fwd_kept, &back, &st_b, &err,
+              lk);
+  Matches m;
+  for (size_t j = 0; j < kept.size(); ++j) {
+    const cv::Point2f& corner = corners[kept[j]];
+    const cv::Point2f d = back[j] - corner;
+    if (!st_b[j] ||
+        d.dot(d) > o.max_forward_backward_px * o.max_forward_backward_px) {
       continue;
-    const int u = cvRound(corners[i].x), w = cvRound(corners[i].y);
-    if (u < 0 || w < 0 || u >= v.depth.cols || w >= v.depth.rows) continue;
-    const float z = v.depth.at<float>(w, u);
-    if (!(z > 0.0f)) continue;
+    }
     // Back-project the corner (exact at the pixel centre it was found on).
-    const Eigen::Vector3d x_cam((corners[i].x - c.cx) / c.fx * z,
-                                (corners[i].y - c.cy) / c.fy * z, z);
+    const float z = depth[j];
+    const Eigen::Vector3d x_cam((corner.x - c.cx) / c.fx * z,
+                                (corner.y - c.cy) / c.fy * z, z);
     const Eigen::Vector3d x = start * x_cam;
     m.object.emplace_back(x.x(), x.y(), x.z());
-    m.image.emplace_back(fwd[i].x, fwd[i].y);
+    m.image.emplace_back(fwd_kept[j].x, fwd_kept[j].y);
   }
   return m;
 }
 
 // RMS reprojection error (px) of the points at pose (r, t).
 double RmsReprojection(const std::vector<cv::Point3d>& object,
-                       const std::vector<cv::Point2d>& image,
-                       const cv::Mat& k, const cv::Mat& r, const cv::Mat& t) {
+                       const std::vector<cv::Point2d>& image, const cv::Mat& k,
+                       const cv::Mat& r, const cv::Mat& t) {
   std::vector<cv::Point2d> proj;
   cv::projectPoints(object, r, t, k, cv::noArray(), proj);
   double sum_sq = 0.0;
@@ -190,18 +240,18 @@ double RmsReprojection(const std::vector<cv::Point3d>& object,
 // threshold. Sets stats' inliers and rms.
 bool SolvePose(const Matches& m, const Camera& c, const MccOptions& o,
                const Rigid3d& start, Rigid3d* out, MccResult* stats) {
-  const cv::Mat k = (cv::Mat_<double>(3, 3) << c.fx, 0, c.cx, 0, c.fy, c.cy,
-                     0, 0, 1);
+  const cv::Mat k =
+      (cv::Mat_<double>(3, 3) << c.fx, 0, c.cx, 0, c.fy, c.cy, 0, 0, 1);
   cv::Mat tvec;
   cv::Mat rvec = CvFromRigid(start.Inverse(), &tvec);
   // RANSAC overwrites its guess; the start pose is refined again below.
   cv::Mat rvec_start = rvec.clone(), tvec_start = tvec.clone();
   std::vector<int> inliers;
-  const bool ok = cv::solvePnPRansac(
-      m.object, m.image, k, cv::noArray(), rvec, tvec,
-      /*useExtrinsicGuess=*/true, o.ransac_iterations,
-      static_cast<float>(o.ransac_threshold_px), 0.999, inliers,
-      cv::SOLVEPNP_ITERATIVE);
+  const bool ok =
+      cv::solvePnPRansac(m.object, m.image, k, cv::noArray(), rvec, tvec,
+                         /*useExtrinsicGuess=*/true, o.ransac_iterations,
+                         static_cast<float>(o.ransac_threshold_px), 0.999,
+                         inliers, cv::SOLVEPNP_ITERATIVE);
   stats->inliers = static_cast<int>(inliers.size());
   if (!ok || static_cast<int>(inliers.size()) < o.min_inliers) return false;
   std::vector<cv::Point3d> in_obj;
@@ -293,7 +343,7 @@ MccResult MonteCarloCorrector::Correct(const cv::Mat& live,
   r.translation_change_m =
       (pose.translation - world_from_cam.translation).norm();
   r.rotation_change_deg =
-      AngleBetween(pose.rotation, world_from_cam.rotation) * 180.0 / M_PI;
+      RadToDegMulDiv(AngleBetween(pose.rotation, world_from_cam.rotation));
   if (r.translation_change_m > options_.max_translation_m ||
       r.rotation_change_deg > options_.max_rotation_deg) {
     return r;

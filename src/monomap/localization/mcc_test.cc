@@ -1,10 +1,11 @@
 #include "monomap/localization/mcc.h"
 
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <cstdio>
+#include <opencv2/imgproc.hpp>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 #include "monomap/localization/measurement_model.h"
 #include "monomap/localization/particle_filter.h"
@@ -14,6 +15,8 @@ namespace monomap {
 namespace {
 
 constexpr double kDeg = M_PI / 180.0;
+// Pitch that leaves part of the room views above the walls (degrees).
+constexpr double kTiltUpDeg = 45.0;
 
 // The synthetic room, a corrector on it and live views of three poses.
 class MccTest : public ::testing::Test {
@@ -93,6 +96,38 @@ TEST_F(MccTest, StopsIteratingOnceARoundMovesLessThanConvergedPx) {
     ASSERT_TRUE(r.accepted);
     EXPECT_EQ(r.rounds, 2);
     EXPECT_LT((r.world_from_cam.translation - truth.translation).norm(), 0.01);
+  }
+}
+
+// Corners are searched in the bounding box of the map's silhouette only;
+// the result must be that of a search of the whole render. Views tilted
+// up show the map over part of the image only.
+TEST_F(MccTest, FindsTheCornersOfTheWholeRenderWhenTheMapCoversPartOfIt) {
+  MccOptions o;
+  o.iterations = 1;
+  const MonteCarloCorrector one(&renderer_, camera_, o);
+  const Renderer biased =
+      renderer_.WithMipBias(renderer_.options().mip_bias + o.extra_mip_bias);
+  for (const auto& [truth, live] : Views()) {
+    const Rigid3d up(truth.rotation * QuaternionFromRotationVector(
+                                          {kTiltUpDeg * kDeg, 0, 0}),
+                     truth.translation);
+    cv::Mat render, depth, mask;
+    biased.Render(one.render_camera(), up, &render, &depth);
+    const double coverage =
+        cv::countNonZero(depth > 0.0f) / static_cast<double>(depth.total());
+    ASSERT_GT(coverage, 0.2);
+    ASSERT_LT(coverage, 0.8);
+    const int side = 2 * o.border_px + 1;
+    cv::erode(depth > 0.0f, mask,
+              cv::getStructuringElement(cv::MORPH_RECT, cv::Size(side, side)));
+    std::vector<cv::Point2f> whole;
+    cv::goodFeaturesToTrack(render, whole, o.max_corners, o.corner_quality,
+                            o.min_corner_distance_px, mask);
+    const MccResult r = one.Correct(live, up);
+    EXPECT_GT(r.corners, 20);
+    EXPECT_EQ(r.corners, static_cast<int>(whole.size()))
+        << "coverage " << coverage;
   }
 }
 

@@ -25,6 +25,9 @@ LiveImagePreparer::LiveImagePreparer(const Camera& camera) : camera_(camera) {
       map_y_.at<float>(v, u) = static_cast<float>(raw.y());
     }
   }
+  // The fixed-point form cv::remap converts float maps to on every call
+  // (same pixels, without the conversion per frame).
+  cv::convertMaps(map_x_, map_y_, map_xy_, map_frac_, CV_16SC2);
 }
 
 cv::Mat LiveImagePreparer::Undistort(const cv::Mat& raw) const {
@@ -47,7 +50,8 @@ cv::Mat LiveImagePreparer::Undistort(const cv::Mat& raw) const {
   }
   if (map_x_.empty()) return grey.clone();
   cv::Mat out;
-  cv::remap(grey, out, map_x_, map_y_, cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+  cv::remap(grey, out, map_xy_, map_frac_, cv::INTER_LINEAR,
+            cv::BORDER_REPLICATE);
   return out;
 }
 

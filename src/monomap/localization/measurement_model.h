@@ -34,6 +34,7 @@ class LiveImagePreparer {
  private:
   Camera camera_;
   cv::Mat map_x_, map_y_;  // empty without distortion
+  cv::Mat map_xy_, map_frac_;  // the same in fixed point (cv::convertMaps)
 };
 
 struct MeasurementOptions {
