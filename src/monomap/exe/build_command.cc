@@ -84,6 +84,27 @@ void AddBundleAdjustmentOptions(CLI::App* cmd, BundleAdjustmentOptions* o) {
                 "Print the bundle adjustment solver's progress and report");
 }
 
+void AddPointTrustOptions(CLI::App* cmd, PointTrustOptions* o) {
+  cmd->add_flag("--keep-all-points", o->keep_all,
+                "Export every triangulated point to points.ply, also those "
+                "the map does not trust (the report still counts them)");
+  cmd->add_option("--min-point-track-length", o->min_track_length,
+                  "Export only points seen in at least this many frames")
+      ->check(CLI::Range(2, 1000000))
+      ->capture_default_str();
+  cmd->add_option("--max-point-reprojection-error",
+                  o->max_mean_reprojection_error_px,
+                  "Export only points whose mean reprojection error after "
+                  "bundle adjustment is at most this (px)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd->add_option("--min-point-angle", o->min_triangulation_angle_deg,
+                  "Export only points whose observing rays span at least "
+                  "this angle (degrees)")
+      ->check(CLI::Range(0.0, 179.9))
+      ->capture_default_str();
+}
+
 void AddMappingOptions(CLI::App* cmd, BuildArgs* a) {
   MappingOptions& o = a->options;
   cmd->add_flag("--no-ba", a->no_bundle_adjustment,
@@ -107,6 +128,7 @@ void AddMappingOptions(CLI::App* cmd, BuildArgs* a) {
                 "Track frame to frame only (no alignment with each "
                 "feature's reference patch)");
   AddBundleAdjustmentOptions(cmd, &o.bundle_adjustment);
+  AddPointTrustOptions(cmd, &o.point_trust);
 }
 
 void RunBuild(const BuildArgs& a) {
