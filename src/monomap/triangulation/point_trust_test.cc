@@ -116,16 +116,16 @@ TEST(PointTrustTest, KeepAllExportsEveryPointAndCountsTheUntrusted) {
 TEST(PointTrustTest, ThresholdsCountExactlyThePointsBeyondThem) {
   const std::vector<Landmark> all = LandmarksWithPlantedBadPoints();
   PointTrustOptions options;
-  options.min_track_length = 20;
+  options.min_track_length = 12;
   options.max_mean_reprojection_error_px = 0.4;
-  options.min_triangulation_angle_deg = 3.0;
+  options.min_triangulation_angle_deg = 6.0;
   int short_track = 0, error = 0, angle = 0;
   for (const Landmark& l : all) {
-    if (l.num_observations < 20) {
+    if (l.num_observations < 12) {
       ++short_track;
     } else if (l.mean_reprojection_error_px > 0.4) {
       ++error;
-    } else if (l.triangulation_angle_deg < 3.0) {
+    } else if (l.triangulation_angle_deg < 6.0) {
       ++angle;
     }
   }
@@ -142,9 +142,9 @@ TEST(PointTrustTest, ThresholdsCountExactlyThePointsBeyondThem) {
             static_cast<int>(all.size()) - short_track - error - angle);
   ASSERT_EQ(kept.size(), static_cast<size_t>(report.num_exported));
   for (const Landmark& l : kept) {
-    EXPECT_GE(l.num_observations, 20);
+    EXPECT_GE(l.num_observations, 12);
     EXPECT_LE(l.mean_reprojection_error_px, 0.4);
-    EXPECT_GE(l.triangulation_angle_deg, 3.0);
+    EXPECT_GE(l.triangulation_angle_deg, 6.0);
   }
   // A NaN quality is never trusted.
   std::vector<Landmark> nan_point(1, all[0]);
