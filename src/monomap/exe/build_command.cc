@@ -169,11 +169,16 @@ void RunBuild(const BuildArgs& a) {
     ThrowIfProblems(WriteReport(in, a.html), a.html);
   }
   if (!a.quiet) {
+    const PointTrustReport& trust = result.report.point_trust;
     std::fprintf(stderr,
-                 "monomap: %d frames, %zu tracks, %zu points, %zu planes "
-                 "in %.2f s (%.1f frames/s) -> %s\n",
+                 "monomap: %d frames, %zu tracks, %zu points exported (%d "
+                 "untrusted %s), %zu planes in %.2f s (%.1f frames/s) -> %s\n",
                  result.report.num_frames, result.tracks.size(),
-                 result.map.landmarks.size(), result.map.planes.size(),
+                 result.map.landmarks.size(),
+                 trust.short_track + trust.reprojection_error +
+                     trust.triangulation_angle,
+                 trust.keep_all ? "kept" : "left out",
+                 result.map.planes.size(),
                  result.report.total_seconds,
                  result.report.num_frames / result.report.total_seconds,
                  a.output.c_str());

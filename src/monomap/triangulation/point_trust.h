@@ -12,11 +12,14 @@
 namespace monomap {
 
 struct PointTrustOptions {
-  // Fewest observations (Landmark::num_observations) of an exported point.
-  int min_track_length = 3;
-  // Largest mean reprojection error (raw px, after bundle adjustment).
+  // Fewest observations (Landmark::num_observations) of an exported point:
+  // the one threshold that helped every run of the generalization set.
+  int min_track_length = 6;
+  // Largest mean reprojection error (raw px, after bundle adjustment); as
+  // triangulation's own limit, since tighter made some runs worse.
   double max_mean_reprojection_error_px = 2.0;
-  // Smallest largest angle between observing rays (degrees).
+  // Smallest largest angle between observing rays (degrees); as
+  // triangulation's own limit, for the same reason.
   double min_triangulation_angle_deg = 1.5;
   // Export every point; the report still counts the untrusted ones.
   bool keep_all = false;
