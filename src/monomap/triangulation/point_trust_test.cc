@@ -15,7 +15,7 @@ namespace {
 constexpr int kClean = 200;
 constexpr int kShort = 6;    // two observations
 constexpr int kJumps = 5;    // jump 15 px half way: large residual
-constexpr int kTiny = 7;     // 3 frames, 6 mm baseline at 0.5 m: ~0.7 deg
+constexpr int kTiny = 7;     // 8 frames, 21 mm baseline at 2.5 m: ~0.5 deg
 
 // Landmarks triangulated (with every acceptance test off) from a noisy
 // simulated scene plus planted bad tracks: the quality the filter judges is
@@ -46,11 +46,11 @@ std::vector<Landmark> LandmarksWithPlantedBadPoints() {
   std::normal_distribution<double> noise(0.0, 0.3);
   for (int k = 0; k < kTiny; ++k) {
     const int frame = 3 * k;
-    const Eigen::Vector3d x = scene.world_from_cam[frame + 1] *
-                              Eigen::Vector3d(0.05 - 0.01 * k, 0.02, 0.5);
+    const Eigen::Vector3d x = scene.world_from_cam[frame + 4] *
+                              Eigen::Vector3d(0.25 - 0.05 * k, 0.1, 2.5);
     Track t;
     t.id = next_id++;
-    for (int f = frame; f < frame + 3; ++f) {
+    for (int f = frame; f < frame + 8; ++f) {
       t.observations.push_back(
           {f, scene.camera.ImageFromCam(scene.world_from_cam[f].Inverse() * x) +
                   Eigen::Vector2d(noise(rng), noise(rng))});
