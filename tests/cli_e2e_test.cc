@@ -113,8 +113,9 @@ TEST_F(Cli, TrustFilterLeavesOutUntrustedPointsAndKeepAllKeepsThem) {
   };
   const auto [all, all_report] = build("keep_all", " --keep-all-points");
   const auto [strict, strict_report] =
-      build("strict", " --min-point-track-length 6 --min-point-angle 4"
-                      " --max-point-reprojection-error 0.5");
+      build("strict",
+            " --min-point-track-length 6 --min-point-angle 4"
+            " --max-point-reprojection-error 0.5");
   const auto [dflt, dflt_report] = build("trusted", "");
 
   const nlohmann::json& a = all_report.at("exported_points");
@@ -169,11 +170,11 @@ TEST_F(Cli, TrustFilterLeavesOutUntrustedPointsAndKeepAllKeepsThem) {
               defaults.min_triangulation_angle_deg - 1e-5);
   }
   // Bad thresholds are usage errors.
-  EXPECT_EQ(RunMonomap("build " + data + " -o " +
-                       (*root_ / "map_bad").string() +
-                       " -q --min-point-track-length 1")
-                .exit_code,
-            2);
+  EXPECT_EQ(
+      RunMonomap("build " + data + " -o " + (*root_ / "map_bad").string() +
+                 " -q --min-point-track-length 1")
+          .exit_code,
+      2);
 }
 
 TEST_F(Cli, MalformedOdometryLineIsNamedAndNothingIsWritten) {

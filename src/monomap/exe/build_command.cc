@@ -177,8 +177,7 @@ void RunBuild(const BuildArgs& a) {
                  result.map.landmarks.size(),
                  trust.short_track + trust.reprojection_error +
                      trust.triangulation_angle,
-                 trust.keep_all ? "kept" : "left out",
-                 result.map.planes.size(),
+                 trust.keep_all ? "kept" : "left out", result.map.planes.size(),
                  result.report.total_seconds,
                  result.report.num_frames / result.report.total_seconds,
                  a.output.c_str());

@@ -477,13 +477,13 @@ void SetPointQuality(const std::vector<std::vector<double>>& columns, size_t i,
                   "track_length", i));
   }
   if (columns[9].size() == n) {
-    l->mean_reprojection_error_px = CheckedQuality(
-        columns[9][i], std::numeric_limits<float>::max(), path,
-        "reprojection_error_px", i);
+    l->mean_reprojection_error_px =
+        CheckedQuality(columns[9][i], std::numeric_limits<float>::max(), path,
+                       "reprojection_error_px", i);
   }
   if (columns[10].size() == n) {
-    l->triangulation_angle_deg = CheckedQuality(
-        columns[10][i], 180.0, path, "triangulation_angle_deg", i);
+    l->triangulation_angle_deg = CheckedQuality(columns[10][i], 180.0, path,
+                                                "triangulation_angle_deg", i);
   }
 }
 

@@ -1,6 +1,6 @@
 // PLY point clouds: monomap's points.ply (xyz, color, feature id, plane
-// label, per-point quality) and reading xyz from any PLY (ascii or binary little endian), e.g.
-// a ground-truth surface cloud.
+// label, per-point quality) and reading xyz from any PLY (ascii or binary
+// little endian), e.g. a ground-truth surface cloud.
 #pragma once
 
 #include <filesystem>

@@ -13,9 +13,9 @@ void PointTrustOptions::Check() const {
                   std::isfinite(max_mean_reprojection_error_px),
               "point_trust.max_mean_reprojection_error_px",
               "must be positive and finite");
-  CheckOption(min_triangulation_angle_deg >= 0.0 &&
-                  min_triangulation_angle_deg < 180.0,
-              "point_trust.min_triangulation_angle_deg", "must be in [0, 180)");
+  CheckOption(
+      min_triangulation_angle_deg >= 0.0 && min_triangulation_angle_deg < 180.0,
+      "point_trust.min_triangulation_angle_deg", "must be in [0, 180)");
 }
 
 PointTrustReport FilterTrustedPoints(const PointTrustOptions& options,

@@ -13,9 +13,9 @@ namespace monomap {
 namespace {
 
 constexpr int kClean = 200;
-constexpr int kShort = 6;    // two observations
-constexpr int kJumps = 5;    // jump 15 px half way: large residual
-constexpr int kTiny = 7;     // 8 frames, 21 mm baseline at 2.5 m: ~0.5 deg
+constexpr int kShort = 6;  // two observations
+constexpr int kJumps = 5;  // jump 15 px half way: large residual
+constexpr int kTiny = 7;   // 8 frames, 21 mm baseline at 2.5 m: ~0.5 deg
 
 // Landmarks triangulated (with every acceptance test off) from a noisy
 // simulated scene plus planted bad tracks: the quality the filter judges is
@@ -149,8 +149,9 @@ TEST(PointTrustTest, ThresholdsCountExactlyThePointsBeyondThem) {
   // A NaN quality is never trusted.
   std::vector<Landmark> nan_point(1, all[0]);
   nan_point[0].mean_reprojection_error_px = std::nan("");
-  EXPECT_EQ(FilterTrustedPoints(PointTrustOptions{}, &nan_point)
-                .reprojection_error, 1);
+  EXPECT_EQ(
+      FilterTrustedPoints(PointTrustOptions{}, &nan_point).reprojection_error,
+      1);
   EXPECT_TRUE(nan_point.empty());
 }
 
@@ -176,11 +177,9 @@ TEST(PointTrustTest, CheckRejectsBadValues) {
             std::string::npos);
   o = {};
   o.min_triangulation_angle_deg = -0.5;
-  EXPECT_NE(error_of(o).find("min_triangulation_angle_deg"),
-            std::string::npos);
+  EXPECT_NE(error_of(o).find("min_triangulation_angle_deg"), std::string::npos);
   o.min_triangulation_angle_deg = 180.0;
-  EXPECT_NE(error_of(o).find("min_triangulation_angle_deg"),
-            std::string::npos);
+  EXPECT_NE(error_of(o).find("min_triangulation_angle_deg"), std::string::npos);
   // The filter checks its options before touching the points.
   std::vector<Landmark> points(3);
   EXPECT_THROW(FilterTrustedPoints(o, &points), OptionsError);
