@@ -245,6 +245,8 @@ MappingResult BuildMap(const Dataset& dataset, const MappingOptions& options) {
   if (!options.points_only) {
     SurfaceStages(dataset, options, camera, world_from_cam, *tracks, &result);
   }
+  // The map exports only the points it trusts; planes and textures above
+  // were fitted from all of them.
   result.report.point_trust =
       FilterTrustedPoints(options.point_trust, &result.map.landmarks);
   result.report.total_seconds = total.ElapsedSeconds();

@@ -88,6 +88,8 @@ struct MappingReport {
 struct MappingResult {
   Map map;
   std::vector<Track> tracks;
+  // Fitted from every point: inlier ids may name landmarks the export's
+  // trust filter left out of map.landmarks.
   std::vector<PlaneSegment> segments;
   // Odometry poses the map was built from (world_from_cam per frame).
   std::vector<Rigid3d> odometry_world_from_cam;
