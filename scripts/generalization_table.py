@@ -40,6 +40,7 @@ def sim_row(out, case):
         "seen_area_m2": e["area"]["seen_area_m2"],
         "large_planes_seen": e["area"]["large_planes_seen"],
         "large_planes_recovered": e["area"]["large_planes_recovered"],
+        "share_above_1cm": e["point_error"]["all_landmarks"].get("share_above_1cm"),
     }
 
 
@@ -65,6 +66,11 @@ def find_stat(obj, want):
     return None
 
 
+def share(fraction):
+    """Percent of points off by more than 1 cm ('-' from an older eval)."""
+    return "-" if fraction is None else f"{100 * fraction:.1f} %"
+
+
 def main():
     out, cases = sys.argv[1], sys.argv[2:]
     sims = [sim_row(out, c) for c in cases]
@@ -73,22 +79,24 @@ def main():
         json.dump({"simulated": sims, "real": reals}, f, indent=1)
     lines = ["| run | h m / pitch deg / fps | build s | map planes | true planes seen / recovered / split"
              " | precision | area recovered (of m^2 seen) | planes >= 1 m^2 recovered"
-             " | points | median error % of distance (p90) |",
-             "|---|---|---|---|---|---|---|---|---|---|"]
+             " | points | median error % of distance (p90) | > 1 cm |",
+             "|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in sims:
         lines.append(
             f"| {r['name'].split('_')[0]} seed {r['seed']} | {r['camera_height_m']:g} / {r['pitch_deg']:g} /"
             f" {r['fps']:g} | {r['build_s']} | {r['fitted_planes']} | {r['observed_true_planes']} /"
             f" {r['recovered_true_planes']} / {r['split_true_planes']} | {r['precision']:.2f} |"
             f" {100 * r['area_recall']:.0f} % ({r['seen_area_m2']:.0f}) |"
-            f" {r['large_planes_recovered']} / {r['large_planes_seen']} | {r['points']} | {r['median_error_percent']:.2f} ({r['p90_error_percent']:.2f}) |")
+            f" {r['large_planes_recovered']} / {r['large_planes_seen']} | {r['points']} | {r['median_error_percent']:.2f} ({r['p90_error_percent']:.2f}) |"
+            f" {share(r['share_above_1cm'])} |")
     for r in reals:
         rel = find_stat(r["eval_points"], "relative") or {}
         ab = find_stat(r["eval_points"], "abs") or {}
         med_mm = ab.get("median", float("nan")) * 1000
         lines.append(
             f"| {r['name']} | real | {r['build_s']} | - | - | - | - | - | {rel.get('count', '-')} |"
-            f" {rel.get('median', float('nan')):.2f} ({rel.get('p90', float('nan')):.2f}); {med_mm:.2f} mm |")
+            f" {rel.get('median', float('nan')):.2f} ({rel.get('p90', float('nan')):.2f}); {med_mm:.2f} mm |"
+            f" {share(r['eval_points'].get('share_above_1cm'))} |")
     with open(os.path.join(out, "generalization.md"), "w") as f:
         f.write("\n".join(lines) + "\n")
     print("\n".join(lines))

@@ -96,6 +96,87 @@ TEST_F(Cli, MaxImageRadiusLeavesTheRimOutOfTheGeometry) {
   EXPECT_EQ(r.exit_code, 2) << r.output;
 }
 
+// The export's trust filter: --keep-all-points exports every triangulated
+// point, the filter leaves out exactly those failing its thresholds (counted
+// per reason from the kept-all map's quality properties), and the report
+// says so.
+TEST_F(Cli, TrustFilterLeavesOutUntrustedPointsAndKeepAllKeepsThem) {
+  const std::string data = (*root_ / "data").string();
+  auto build = [&](const std::string& name, const std::string& args) {
+    const fs::path out = *root_ / ("map_" + name);
+    const fs::path report = *root_ / ("report_" + name + ".json");
+    const RunResult r = RunMonomap("build " + data + " -o " + out.string() +
+                                   " -q --report " + report.string() + args);
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+    std::ifstream in(report);
+    return std::make_pair(ReadMap(out), nlohmann::json::parse(in));
+  };
+  const auto [all, all_report] = build("keep_all", " --keep-all-points");
+  const auto [strict, strict_report] =
+      build("strict",
+            " --min-point-track-length 6 --min-point-angle 4"
+            " --max-point-reprojection-error 0.5");
+  const auto [dflt, dflt_report] = build("trusted", "");
+
+  const nlohmann::json& a = all_report.at("exported_points");
+  EXPECT_TRUE(a.at("keep_all_points").get<bool>());
+  EXPECT_EQ(a.at("exported").get<size_t>(), all.landmarks.size());
+  EXPECT_EQ(a.at("points").get<size_t>(), all.landmarks.size());
+  EXPECT_GT(all.landmarks.size(), 50u);
+
+  // Recount the strict thresholds over the kept-all points (first failing
+  // test claims a point, as documented).
+  int short_track = 0, error = 0, angle = 0;
+  for (const Landmark& l : all.landmarks) {
+    EXPECT_GE(l.num_observations, 3);  // the quality came through the PLY
+    EXPECT_GT(l.triangulation_angle_deg, 0.0);
+    if (l.num_observations < 6) {
+      ++short_track;
+    } else if (l.mean_reprojection_error_px > 0.5) {
+      ++error;
+    } else if (l.triangulation_angle_deg < 4.0) {
+      ++angle;
+    }
+  }
+  EXPECT_GT(short_track + error + angle, 0);
+  const nlohmann::json& s = strict_report.at("exported_points");
+  EXPECT_FALSE(s.at("keep_all_points").get<bool>());
+  EXPECT_EQ(s.at("points").get<size_t>(), all.landmarks.size());
+  EXPECT_EQ(s.at("left_out").at("short_track").get<int>(), short_track);
+  EXPECT_EQ(s.at("left_out").at("reprojection_error").get<int>(), error);
+  EXPECT_EQ(s.at("left_out").at("triangulation_angle").get<int>(), angle);
+  EXPECT_EQ(s.at("exported").get<size_t>(), strict.landmarks.size());
+  EXPECT_EQ(strict.landmarks.size(),
+            all.landmarks.size() - short_track - error - angle);
+  for (const Landmark& l : strict.landmarks) {
+    EXPECT_GE(l.num_observations, 6);
+    EXPECT_LE(l.mean_reprojection_error_px, 0.5 + 1e-6);  // stored as float
+    EXPECT_GE(l.triangulation_angle_deg, 4.0 - 1e-5);
+  }
+  // The default build exports what the default thresholds trust.
+  const nlohmann::json& d = dflt_report.at("exported_points");
+  const PointTrustOptions defaults;
+  EXPECT_EQ(d.at("exported").get<size_t>(), dflt.landmarks.size());
+  EXPECT_EQ(d.at("exported").get<int>() +
+                d.at("left_out").at("short_track").get<int>() +
+                d.at("left_out").at("reprojection_error").get<int>() +
+                d.at("left_out").at("triangulation_angle").get<int>(),
+            d.at("points").get<int>());
+  for (const Landmark& l : dflt.landmarks) {
+    EXPECT_GE(l.num_observations, defaults.min_track_length);
+    EXPECT_LE(l.mean_reprojection_error_px,
+              defaults.max_mean_reprojection_error_px + 1e-6);  // float
+    EXPECT_GE(l.triangulation_angle_deg,
+              defaults.min_triangulation_angle_deg - 1e-5);
+  }
+  // Bad thresholds are usage errors.
+  EXPECT_EQ(
+      RunMonomap("build " + data + " -o " + (*root_ / "map_bad").string() +
+                 " -q --min-point-track-length 1")
+          .exit_code,
+      2);
+}
+
 TEST_F(Cli, MalformedOdometryLineIsNamedAndNothingIsWritten) {
   const fs::path data = CopyData("bad_odometry");
   {

@@ -45,6 +45,13 @@ ErrorStats ComputeErrorStats(std::vector<double> values) {
   return s;
 }
 
+double ShareAbove(const std::vector<double>& values, double threshold) {
+  if (values.empty()) return 0.0;
+  const auto above = std::count_if(values.begin(), values.end(),
+                                   [&](double v) { return v > threshold; });
+  return static_cast<double>(above) / static_cast<double>(values.size());
+}
+
 namespace {
 
 PointAccuracy AccuracyFromErrors(const std::vector<double>& errors,
@@ -55,6 +62,7 @@ PointAccuracy AccuracyFromErrors(const std::vector<double>& errors,
   }
   PointAccuracy acc;
   acc.absolute_m = ComputeErrorStats(errors);
+  acc.share_above_1cm = ShareAbove(errors, 0.01);
   acc.relative_percent = ComputeErrorStats(std::move(relative));
   return acc;
 }

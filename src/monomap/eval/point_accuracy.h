@@ -37,7 +37,13 @@ struct PointAccuracy {
   // error / distance to camera * 100: scale-free, since depth error grows
   // with distance for a monocular reconstruction.
   ErrorStats relative_percent;
+  // Fraction of the points whose absolute error exceeds 1 cm: the points a
+  // user would call wrong, which a median hides.
+  double share_above_1cm = 0.0;
 };
+
+// Fraction of `values` above `threshold` (0 for no values).
+double ShareAbove(const std::vector<double>& values, double threshold);
 
 // Absolute point-to-plane distances. `distance_to_camera_m` (same size as
 // `points`, each > 0) gives the denominator of the relative error. Throws

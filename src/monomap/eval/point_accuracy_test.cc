@@ -77,6 +77,11 @@ TEST(PointAccuracyTest, PlaneWithKnownOffsets) {
   // (i+1) mm at (i+1) m is 0.1 % for every point.
   EXPECT_NEAR(acc.relative_percent.mean, 0.1, 1e-9);
   EXPECT_NEAR(acc.relative_percent.max, 0.1, 1e-9);
+  // 1..10 mm: none clearly above 1 cm; 9 and 10 mm above 8.5 mm.
+  EXPECT_LE(acc.share_above_1cm, 0.1);
+  EXPECT_EQ(ShareAbove({1e-3, 9e-3, 10e-3, 2e-3}, 8.5e-3), 0.5);
+  EXPECT_EQ(ShareAbove({0.02, 0.005, 0.011}, 0.01), 2.0 / 3.0);
+  EXPECT_EQ(ShareAbove({}, 0.01), 0.0);
 
   distances.pop_back();
   EXPECT_THROW(EvaluatePointsAgainstPlane(points, distances, plane),

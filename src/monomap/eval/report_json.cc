@@ -11,7 +11,8 @@ nlohmann::json ToJson(const ErrorStats& s) {
 
 nlohmann::json ToJson(const PointAccuracy& a) {
   return {{"absolute_m", ToJson(a.absolute_m)},
-          {"relative_percent", ToJson(a.relative_percent)}};
+          {"relative_percent", ToJson(a.relative_percent)},
+          {"share_above_1cm", a.share_above_1cm}};
 }
 
 nlohmann::json ToJson(const TrajectoryErrors& e) {

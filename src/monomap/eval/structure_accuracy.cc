@@ -93,9 +93,11 @@ void ScorePoints(const Map& map, const Map& truth,
     }
   }
   result->point_error_all = {ComputeErrorStats(abs_all),
-                             ComputeErrorStats(rel_all)};
+                             ComputeErrorStats(rel_all),
+                             ShareAbove(abs_all, 0.01)};
   result->point_error_on_planes = {ComputeErrorStats(abs_on),
-                                   ComputeErrorStats(rel_on)};
+                                   ComputeErrorStats(rel_on),
+                                   ShareAbove(abs_on, 0.01)};
 }
 
 // The true plane most of the fitted plane's inliers lie on, or when none

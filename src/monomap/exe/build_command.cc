@@ -116,6 +116,27 @@ void AddLensOptions(CLI::App* cmd, IntrinsicsRefinementOptions* o) {
       ->capture_default_str();
 }
 
+void AddPointTrustOptions(CLI::App* cmd, PointTrustOptions* o) {
+  cmd->add_flag("--keep-all-points", o->keep_all,
+                "Export every triangulated point to points.ply, also those "
+                "the map does not trust (the report still counts them)");
+  cmd->add_option("--min-point-track-length", o->min_track_length,
+                  "Export only points seen in at least this many frames")
+      ->check(CLI::Range(2, 1000000))
+      ->capture_default_str();
+  cmd->add_option("--max-point-reprojection-error",
+                  o->max_mean_reprojection_error_px,
+                  "Export only points whose mean reprojection error after "
+                  "bundle adjustment is at most this (px)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd->add_option("--min-point-angle", o->min_triangulation_angle_deg,
+                  "Export only points whose observing rays span at least "
+                  "this angle (degrees)")
+      ->check(CLI::Range(0.0, 179.9))
+      ->capture_default_str();
+}
+
 void AddMappingOptions(CLI::App* cmd, BuildArgs* a) {
   MappingOptions& o = a->options;
   cmd->add_flag("--no-ba", a->no_bundle_adjustment,
@@ -143,6 +164,7 @@ void AddMappingOptions(CLI::App* cmd, BuildArgs* a) {
                 "feature's reference patch)");
   AddBundleAdjustmentOptions(cmd, &o.bundle_adjustment);
   AddLensOptions(cmd, &o.bundle_adjustment.intrinsics);
+  AddPointTrustOptions(cmd, &o.point_trust);
 }
 
 void RunBuild(const BuildArgs& a) {
@@ -185,11 +207,15 @@ void RunBuild(const BuildArgs& a) {
     ThrowIfProblems(WriteReport(in, a.html), a.html);
   }
   if (!a.quiet) {
+    const PointTrustReport& trust = result.report.point_trust;
     std::fprintf(stderr,
-                 "monomap: %d frames, %zu tracks, %zu points, %zu planes "
-                 "in %.2f s (%.1f frames/s) -> %s\n",
+                 "monomap: %d frames, %zu tracks, %zu points exported (%d "
+                 "untrusted %s), %zu planes in %.2f s (%.1f frames/s) -> %s\n",
                  result.report.num_frames, result.tracks.size(),
-                 result.map.landmarks.size(), result.map.planes.size(),
+                 result.map.landmarks.size(),
+                 trust.short_track + trust.reprojection_error +
+                     trust.triangulation_angle,
+                 trust.keep_all ? "kept" : "left out", result.map.planes.size(),
                  result.report.total_seconds,
                  result.report.num_frames / result.report.total_seconds,
                  a.output.c_str());

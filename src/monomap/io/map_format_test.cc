@@ -69,6 +69,9 @@ Map MakeTestMap() {
     l.x_in_world = {x(rng), x(rng), x(rng)};
     l.color = Eigen::Vector3f(i * 20, 255 - i, 7);
     l.plane_id = i % 3 == 0 ? -1 : (i % 3 == 1 ? 0 : 3);
+    l.num_observations = 3 + 5 * i;
+    l.mean_reprojection_error_px = 0.125 * i;  // exact in float
+    l.triangulation_angle_deg = 1.5 + 0.25 * i;
     map.landmarks.push_back(l);
   }
   for (int i = 0; i < 6; ++i) {
@@ -177,6 +180,12 @@ TEST(MapFormatTest, RoundTripKeepsEveryField) {
     EXPECT_EQ(read.landmarks[i].id, map.landmarks[i].id);
     EXPECT_EQ(read.landmarks[i].plane_id, map.landmarks[i].plane_id);
     EXPECT_EQ(read.landmarks[i].color, map.landmarks[i].color);
+    EXPECT_EQ(read.landmarks[i].num_observations,
+              map.landmarks[i].num_observations);
+    EXPECT_EQ(read.landmarks[i].mean_reprojection_error_px,
+              map.landmarks[i].mean_reprojection_error_px);
+    EXPECT_EQ(read.landmarks[i].triangulation_angle_deg,
+              map.landmarks[i].triangulation_angle_deg);
     EXPECT_LT((read.landmarks[i].x_in_world - map.landmarks[i].x_in_world)
                   .norm(),
               1e-6);  // stored as float

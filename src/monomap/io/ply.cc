@@ -454,6 +454,39 @@ double CheckedId(double v, double lo, double hi,
   return v;
 }
 
+// A per-point quality value read as a double, checked to be finite and in
+// [0, hi].
+double CheckedQuality(double v, double hi, const std::filesystem::path& path,
+                      const char* field, size_t row) {
+  if (!(v >= 0.0 && v <= hi)) {
+    throw InputError(path.string() + ": vertex " + std::to_string(row) + ": '" +
+                     field + "' " + std::to_string(v) + " is not in [0, " +
+                     std::to_string(hi) + "]");
+  }
+  return v;
+}
+
+// The quality columns (track_length, reprojection_error_px,
+// triangulation_angle_deg) of vertex i, each when present.
+void SetPointQuality(const std::vector<std::vector<double>>& columns, size_t i,
+                     const std::filesystem::path& path, Landmark* l) {
+  const size_t n = columns[0].size();
+  if (columns[8].size() == n) {
+    l->num_observations = static_cast<int>(
+        CheckedId(columns[8][i], 0, std::numeric_limits<int>::max(), path,
+                  "track_length", i));
+  }
+  if (columns[9].size() == n) {
+    l->mean_reprojection_error_px =
+        CheckedQuality(columns[9][i], std::numeric_limits<float>::max(), path,
+                       "reprojection_error_px", i);
+  }
+  if (columns[10].size() == n) {
+    l->triangulation_angle_deg = CheckedQuality(columns[10][i], 180.0, path,
+                                                "triangulation_angle_deg", i);
+  }
+}
+
 }  // namespace
 
 std::vector<Eigen::Vector3d> ReadPlyPoints(const std::filesystem::path& path) {
@@ -467,7 +500,10 @@ std::vector<Eigen::Vector3d> ReadPlyPoints(const std::filesystem::path& path) {
 
 std::vector<Landmark> ReadLandmarksPly(const std::filesystem::path& path) {
   const auto columns = ReadVertexColumns(
-      path, {"x", "y", "z", "red", "green", "blue", "feature_id", "plane"}, 3);
+      path,
+      {"x", "y", "z", "red", "green", "blue", "feature_id", "plane",
+       "track_length", "reprojection_error_px", "triangulation_angle_deg"},
+      3);
   const size_t n = columns[0].size();
   const bool has_color =
       columns[3].size() == n && columns[4].size() == n && columns[5].size() == n;
@@ -488,6 +524,7 @@ std::vector<Landmark> ReadLandmarksPly(const std::filesystem::path& path) {
                            columns[7][i], -1, std::numeric_limits<int>::max(),
                            path, "plane", i))
                      : -1;
+    SetPointQuality(columns, i, path, &l);
   }
   return landmarks;
 }
@@ -502,8 +539,11 @@ void WriteLandmarksPly(const std::filesystem::path& path,
          << "property float x\nproperty float y\nproperty float z\n"
          << "property uchar red\nproperty uchar green\nproperty uchar blue\n"
          << "property int feature_id\nproperty int plane\n"
+         << "property int track_length\n"
+         << "property float reprojection_error_px\n"
+         << "property float triangulation_angle_deg\n"
          << "end_header\n";
-  constexpr size_t kStride = 3 * 4 + 3 + 4 + 4;
+  constexpr size_t kStride = 3 * 4 + 3 + 4 + 4 + 4 + 4 + 4;
   std::string out = header.str();
   const size_t start = out.size();
   out.resize(start + landmarks.size() * kStride);
@@ -515,6 +555,16 @@ void WriteLandmarksPly(const std::filesystem::path& path,
                         std::to_string(l.id) +
                         " does not fit the PLY int property");
     }
+    // What ReadLandmarksPly would refuse is refused here, before writing.
+    if (l.num_observations < 0 ||
+        !(l.mean_reprojection_error_px >= 0.0 &&
+          l.mean_reprojection_error_px <= std::numeric_limits<float>::max()) ||
+        !(l.triangulation_angle_deg >= 0.0 &&
+          l.triangulation_angle_deg <= 180.0)) {
+      throw OutputError(path.string() + ": landmark " + std::to_string(l.id) +
+                        " has an invalid track length, reprojection error "
+                        "or triangulation angle");
+    }
     const float xyz[3] = {static_cast<float>(l.x_in_world.x()),
                           static_cast<float>(l.x_in_world.y()),
                           static_cast<float>(l.x_in_world.z())};
@@ -525,10 +575,15 @@ void WriteLandmarksPly(const std::filesystem::path& path,
       *p++ = static_cast<char>(
           static_cast<uint8_t>(std::lround(std::clamp(v, 0.0f, 255.0f))));
     }
-    const int32_t ids[2] = {static_cast<int32_t>(l.id),
-                            static_cast<int32_t>(l.plane_id)};
+    const int32_t ids[3] = {static_cast<int32_t>(l.id),
+                            static_cast<int32_t>(l.plane_id),
+                            static_cast<int32_t>(l.num_observations)};
     std::memcpy(p, ids, sizeof(ids));
     p += sizeof(ids);
+    const float quality[2] = {static_cast<float>(l.mean_reprojection_error_px),
+                              static_cast<float>(l.triangulation_angle_deg)};
+    std::memcpy(p, quality, sizeof(quality));
+    p += sizeof(quality);
   }
   WriteFileAtomic(path, out);
 }

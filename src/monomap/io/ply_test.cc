@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstring>
 #include <fstream>
 #include <random>
@@ -49,6 +50,9 @@ std::vector<Landmark> RandomLandmarks(int n) {
     landmarks[i].x_in_world = {x(rng), x(rng), x(rng)};
     landmarks[i].color = Eigen::Vector3f(c(rng), c(rng), c(rng));
     landmarks[i].plane_id = i % 4 - 1;
+    landmarks[i].num_observations = 3 + i % 200;
+    landmarks[i].mean_reprojection_error_px = 0.01 * (i % 300);
+    landmarks[i].triangulation_angle_deg = 0.37 * (i % 400);
   }
   return landmarks;
 }
@@ -57,9 +61,9 @@ TEST(PlyTest, LandmarksRoundTrip) {
   const auto landmarks = RandomLandmarks(500);
   const fs::path path = TempFile("landmarks.ply");
   WriteLandmarksPly(path, landmarks);
-  // 23 bytes per vertex after the header.
+  // 35 bytes per vertex after the header.
   const std::string data = ReadFileToString(path);
-  EXPECT_EQ(data.size() - (data.find("end_header\n") + 11), 500u * 23u);
+  EXPECT_EQ(data.size() - (data.find("end_header\n") + 11), 500u * 35u);
 
   const auto points = ReadPlyPoints(path);
   ASSERT_EQ(points.size(), landmarks.size());
@@ -76,10 +80,89 @@ TEST(PlyTest, LandmarksRoundTrip) {
     EXPECT_EQ(read[i].id, landmarks[i].id);
     EXPECT_EQ(read[i].plane_id, landmarks[i].plane_id);
     EXPECT_EQ(read[i].color, landmarks[i].color);
+    EXPECT_EQ(read[i].num_observations, landmarks[i].num_observations);
+    // Float precision.
+    EXPECT_NEAR(read[i].mean_reprojection_error_px,
+                landmarks[i].mean_reprojection_error_px, 1e-6);
+    EXPECT_NEAR(read[i].triangulation_angle_deg,
+                landmarks[i].triangulation_angle_deg, 2e-5);
   }
 
   WriteLandmarksPly(path, {});
   EXPECT_TRUE(ReadPlyPoints(path).empty());
+}
+
+// points.ply as written before the quality properties (23 bytes a vertex):
+// still loads, quality left at zero.
+TEST(PlyTest, ReadsLandmarksWithoutQualityProperties) {
+  std::string ply =
+      "ply\nformat binary_little_endian 1.0\n"
+      "comment monomap landmarks (world frame, metres)\nelement vertex 2\n"
+      "property float x\nproperty float y\nproperty float z\n"
+      "property uchar red\nproperty uchar green\nproperty uchar blue\n"
+      "property int feature_id\nproperty int plane\nend_header\n";
+  for (int i = 0; i < 2; ++i) {
+    Append<float>(&ply, 1.5f + i);
+    Append<float>(&ply, -2.0f);
+    Append<float>(&ply, 0.25f * i);
+    for (uint8_t c : {10, 20, 30}) Append<uint8_t>(&ply, c + i);
+    Append<int32_t>(&ply, 70 + i);
+    Append<int32_t>(&ply, i - 1);
+  }
+  const fs::path path = TempFile("old_format.ply");
+  WriteBytes(path, ply);
+  const auto read = ReadLandmarksPly(path);
+  ASSERT_EQ(read.size(), 2u);
+  for (int i = 0; i < 2; ++i) {
+    EXPECT_EQ(read[i].x_in_world, Eigen::Vector3d(1.5 + i, -2.0, 0.25 * i));
+    EXPECT_EQ(read[i].color, Eigen::Vector3f(10 + i, 20 + i, 30 + i));
+    EXPECT_EQ(read[i].id, 70 + i);
+    EXPECT_EQ(read[i].plane_id, i - 1);
+    EXPECT_EQ(read[i].num_observations, 0);
+    EXPECT_EQ(read[i].mean_reprojection_error_px, 0.0);
+    EXPECT_EQ(read[i].triangulation_angle_deg, 0.0);
+  }
+}
+
+TEST(PlyTest, RejectsQualityOutOfRange) {
+  const fs::path path = TempFile("quality.ply");
+  const std::string head =
+      "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\n"
+      "property float y\nproperty float z\nproperty int track_length\n"
+      "property float reprojection_error_px\n"
+      "property float triangulation_angle_deg\nend_header\n1 2 3 4 0.5 2\n";
+  const struct {
+    const char* row;
+    const char* field;
+  } kBad[] = {{"1 2 3 -1 0.5 2\n", "'track_length'"},
+              {"1 2 3 2.5 0.5 2\n", "'track_length'"},
+              {"1 2 3 4 -0.5 2\n", "'reprojection_error_px'"},
+              {"1 2 3 4 0.5 181\n", "'triangulation_angle_deg'"}};
+  for (const auto& bad : kBad) {
+    WriteBytes(path, head + bad.row);
+    try {
+      ReadLandmarksPly(path);
+      ADD_FAILURE() << "expected InputError for " << bad.row;
+    } catch (const InputError& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find("quality.ply: vertex 1"), std::string::npos) << what;
+      EXPECT_NE(what.find(bad.field), std::string::npos) << what;
+    }
+  }
+  WriteBytes(path, head + "1 2 3 5 0.25 3.5\n");
+  const auto read = ReadLandmarksPly(path);
+  ASSERT_EQ(read.size(), 2u);
+  EXPECT_EQ(read[1].num_observations, 5);
+  EXPECT_EQ(read[1].mean_reprojection_error_px, 0.25);
+  EXPECT_EQ(read[1].triangulation_angle_deg, 3.5);
+
+  // The writer refuses what the reader would refuse.
+  auto landmarks = RandomLandmarks(3);
+  landmarks[1].mean_reprojection_error_px = std::nan("");
+  EXPECT_THROW(WriteLandmarksPly(path, landmarks), OutputError);
+  landmarks[1].mean_reprojection_error_px = 0.5;
+  landmarks[2].triangulation_angle_deg = -1.0;
+  EXPECT_THROW(WriteLandmarksPly(path, landmarks), OutputError);
 }
 
 TEST(PlyTest, ReadsAsciiWithOtherPropertiesAndElements) {

@@ -21,6 +21,7 @@ void MappingOptions::Check() const {
   planes.Check();
   homographies.Check();
   mosaic.Check();
+  point_trust.Check();
   keyframes.Check();
   CheckOption(first_pass_error_factor >= 1.0, "mapping.first_pass_error_factor",
               "must be >= 1");
@@ -255,6 +256,10 @@ MappingResult BuildMap(const Dataset& dataset, const MappingOptions& options) {
   if (!options.points_only) {
     SurfaceStages(dataset, options, camera, world_from_cam, *tracks, &result);
   }
+  // The map exports only the points it trusts; planes and textures above
+  // were fitted from all of them.
+  result.report.point_trust =
+      FilterTrustedPoints(options.point_trust, &result.map.landmarks);
   result.report.total_seconds = total.ElapsedSeconds();
   return result;
 }
@@ -370,6 +375,15 @@ nlohmann::json MappingReport::ToJson() const {
          {"feature_residual_max_px", m.feature_residual_max_px}});
   }
   j["mosaics"] = mosaics;
+  j["exported_points"] = {
+      {"points", point_trust.num_points},
+      {"exported", point_trust.num_exported},
+      {"keep_all_points", point_trust.keep_all},
+      // Per reason: left out, or with keep_all_points exported untrusted.
+      {point_trust.keep_all ? "untrusted_kept" : "left_out",
+       {{"short_track", point_trust.short_track},
+        {"reprojection_error", point_trust.reprojection_error},
+        {"triangulation_angle", point_trust.triangulation_angle}}}};
   nlohmann::json t = nlohmann::json::object();
   for (const auto& s : timings) t[s.name] = s.seconds;
   j["timings_seconds"] = t;

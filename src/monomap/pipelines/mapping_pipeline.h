@@ -16,6 +16,7 @@
 #include "monomap/tracking/klt_tracker.h"
 #include "monomap/triangulation/bundle_adjustment.h"
 #include "monomap/triangulation/keyframe_adjustment.h"
+#include "monomap/triangulation/point_trust.h"
 #include "monomap/triangulation/triangulator.h"
 
 namespace monomap {
@@ -33,6 +34,9 @@ struct MappingOptions {
   HomographyOptions homographies;
   // Stage 5: texture mosaics.
   MosaicOptions mosaic;
+  // Last: which points the map exports (untrusted ones left out unless
+  // point_trust.keep_all). Planes and textures use every point.
+  PointTrustOptions point_trust;
   // The first triangulation (against odometry poses, before bundle
   // adjustment) accepts reprojection errors this many times larger.
   double first_pass_error_factor = 4.0;
@@ -73,6 +77,8 @@ struct MappingReport {
   PlaneFittingReport planes;
   HomographyReport homographies;
   MosaicReport mosaic;
+  // Points exported and left out (by reason) by the trust filter.
+  PointTrustReport point_trust;
   std::vector<StageTiming> timings;
   double total_seconds = 0.0;
 
@@ -82,6 +88,8 @@ struct MappingReport {
 struct MappingResult {
   Map map;
   std::vector<Track> tracks;
+  // Fitted from every point: inlier ids may name landmarks the export's
+  // trust filter left out of map.landmarks.
   std::vector<PlaneSegment> segments;
   // Odometry poses the map was built from (world_from_cam per frame).
   std::vector<Rigid3d> odometry_world_from_cam;

@@ -1,0 +1,53 @@
+#include "monomap/triangulation/point_trust.h"
+
+#include <cmath>
+
+#include "monomap/util/error.h"
+
+namespace monomap {
+
+void PointTrustOptions::Check() const {
+  CheckOption(min_track_length >= 2, "point_trust.min_track_length",
+              "must be >= 2 (a point needs two views)");
+  CheckOption(max_mean_reprojection_error_px > 0.0 &&
+                  std::isfinite(max_mean_reprojection_error_px),
+              "point_trust.max_mean_reprojection_error_px",
+              "must be positive and finite");
+  CheckOption(
+      min_triangulation_angle_deg >= 0.0 && min_triangulation_angle_deg < 180.0,
+      "point_trust.min_triangulation_angle_deg", "must be in [0, 180)");
+}
+
+PointTrustReport FilterTrustedPoints(const PointTrustOptions& options,
+                                     std::vector<Landmark>* landmarks) {
+  options.Check();
+  PointTrustReport report;
+  report.keep_all = options.keep_all;
+  report.num_points = static_cast<int>(landmarks->size());
+  size_t kept = 0;
+  for (size_t i = 0; i < landmarks->size(); ++i) {
+    const Landmark& l = (*landmarks)[i];
+    // Written so that a NaN quality fails its test.
+    bool trusted = false;
+    if (l.num_observations < options.min_track_length) {
+      ++report.short_track;
+    } else if (!(l.mean_reprojection_error_px <=
+                 options.max_mean_reprojection_error_px)) {
+      ++report.reprojection_error;
+    } else if (!(l.triangulation_angle_deg >=
+                 options.min_triangulation_angle_deg)) {
+      ++report.triangulation_angle;
+    } else {
+      trusted = true;
+    }
+    if (trusted || options.keep_all) {
+      if (kept != i) (*landmarks)[kept] = std::move((*landmarks)[i]);
+      ++kept;
+    }
+  }
+  landmarks->resize(kept);
+  report.num_exported = static_cast<int>(kept);
+  return report;
+}
+
+}  // namespace monomap

@@ -1,0 +1,190 @@
+#include "monomap/triangulation/point_trust.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <random>
+
+#include "monomap/sim/synthetic_scene.h"
+#include "monomap/triangulation/triangulator.h"
+#include "monomap/util/error.h"
+
+namespace monomap {
+namespace {
+
+constexpr int kClean = 200;
+constexpr int kShort = 6;  // two observations
+constexpr int kJumps = 5;  // jump 15 px half way: large residual
+constexpr int kTiny = 7;   // 8 frames, 21 mm baseline at 2.5 m: ~0.5 deg
+
+// Landmarks triangulated (with every acceptance test off) from a noisy
+// simulated scene plus planted bad tracks: the quality the filter judges is
+// the one triangulation measured. Ids >= kClean are the planted ones.
+std::vector<Landmark> LandmarksWithPlantedBadPoints() {
+  SyntheticSceneOptions scene_options;
+  scene_options.num_tracks = kClean;
+  scene_options.pixel_noise_px = 0.3;
+  scene_options.seed = 11;
+  const SyntheticScene scene = MakeSyntheticScene(scene_options);
+  std::vector<Track> tracks = scene.tracks;
+  FeatureId next_id = kClean;
+  for (int k = 0; k < kShort; ++k) {
+    Track t = scene.tracks[k];
+    t.id = next_id++;
+    t.observations.resize(2);
+    tracks.push_back(t);
+  }
+  for (int k = 0; k < kJumps; ++k) {
+    Track t = scene.tracks[10 + k];
+    t.id = next_id++;
+    for (size_t i = t.observations.size() / 2; i < t.observations.size(); ++i) {
+      t.observations[i].px += Eigen::Vector2d(0.0, -15.0);
+    }
+    tracks.push_back(t);
+  }
+  std::mt19937_64 rng(4);
+  std::normal_distribution<double> noise(0.0, 0.3);
+  for (int k = 0; k < kTiny; ++k) {
+    const int frame = 3 * k;
+    const Eigen::Vector3d x = scene.world_from_cam[frame + 4] *
+                              Eigen::Vector3d(0.25 - 0.05 * k, 0.1, 2.5);
+    Track t;
+    t.id = next_id++;
+    for (int f = frame; f < frame + 8; ++f) {
+      t.observations.push_back(
+          {f, scene.camera.ImageFromCam(scene.world_from_cam[f].Inverse() * x) +
+                  Eigen::Vector2d(noise(rng), noise(rng))});
+    }
+    tracks.push_back(t);
+  }
+  TriangulationOptions accept_all;
+  accept_all.min_track_length = 2;
+  accept_all.max_reprojection_error_px = 1e6;
+  accept_all.max_observation_error_px = 1e6;
+  accept_all.min_triangulation_angle_deg = 0.0;
+  std::vector<Landmark> landmarks;
+  TriangulateTracks(scene.camera, scene.world_from_cam, tracks, accept_all,
+                    &landmarks);
+  return landmarks;
+}
+
+TEST(PointTrustTest, LeavesOutThePlantedBadPointsAndKeepsTheGoodOnes) {
+  const std::vector<Landmark> all = LandmarksWithPlantedBadPoints();
+  ASSERT_EQ(all.size(), static_cast<size_t>(kClean + kShort + kJumps + kTiny));
+  // The planted points really carry the bad quality.
+  for (const Landmark& l : all) {
+    if (l.id >= kClean + kShort && l.id < kClean + kShort + kJumps) {
+      EXPECT_GT(l.mean_reprojection_error_px, 4.0) << l.id;
+    } else if (l.id >= kClean + kShort + kJumps) {
+      EXPECT_LT(l.triangulation_angle_deg, 1.0) << l.id;
+      EXPECT_LT(l.mean_reprojection_error_px, 1.0) << l.id;
+    }
+  }
+  std::vector<Landmark> kept = all;
+  const PointTrustReport report =
+      FilterTrustedPoints(PointTrustOptions{}, &kept);
+  EXPECT_EQ(report.num_points, static_cast<int>(all.size()));
+  EXPECT_EQ(report.num_exported, kClean);
+  EXPECT_EQ(report.short_track, kShort);
+  EXPECT_EQ(report.reprojection_error, kJumps);
+  EXPECT_EQ(report.triangulation_angle, kTiny);
+  EXPECT_FALSE(report.keep_all);
+  ASSERT_EQ(kept.size(), static_cast<size_t>(kClean));
+  for (int i = 0; i < kClean; ++i) {
+    EXPECT_EQ(kept[i].id, i);  // the clean ones, in order
+    EXPECT_EQ(kept[i].x_in_world, all[i].x_in_world);
+  }
+}
+
+TEST(PointTrustTest, KeepAllExportsEveryPointAndCountsTheUntrusted) {
+  const std::vector<Landmark> all = LandmarksWithPlantedBadPoints();
+  std::vector<Landmark> kept = all;
+  PointTrustOptions options;
+  options.keep_all = true;
+  const PointTrustReport report = FilterTrustedPoints(options, &kept);
+  EXPECT_TRUE(report.keep_all);
+  EXPECT_EQ(report.num_exported, static_cast<int>(all.size()));
+  EXPECT_EQ(report.short_track, kShort);
+  EXPECT_EQ(report.reprojection_error, kJumps);
+  EXPECT_EQ(report.triangulation_angle, kTiny);
+  ASSERT_EQ(kept.size(), all.size());
+  for (size_t i = 0; i < all.size(); ++i) EXPECT_EQ(kept[i].id, all[i].id);
+}
+
+// Each threshold counts exactly the points beyond it, and the first failing
+// test claims a point.
+TEST(PointTrustTest, ThresholdsCountExactlyThePointsBeyondThem) {
+  const std::vector<Landmark> all = LandmarksWithPlantedBadPoints();
+  PointTrustOptions options;
+  options.min_track_length = 12;
+  options.max_mean_reprojection_error_px = 0.4;
+  options.min_triangulation_angle_deg = 6.0;
+  int short_track = 0, error = 0, angle = 0;
+  for (const Landmark& l : all) {
+    if (l.num_observations < 12) {
+      ++short_track;
+    } else if (l.mean_reprojection_error_px > 0.4) {
+      ++error;
+    } else if (l.triangulation_angle_deg < 6.0) {
+      ++angle;
+    }
+  }
+  // The scene spans all three cases, so each test is exercised.
+  EXPECT_GT(short_track, kShort + kTiny);
+  EXPECT_GT(error, kJumps);
+  EXPECT_GT(angle, 0);
+  std::vector<Landmark> kept = all;
+  const PointTrustReport report = FilterTrustedPoints(options, &kept);
+  EXPECT_EQ(report.short_track, short_track);
+  EXPECT_EQ(report.reprojection_error, error);
+  EXPECT_EQ(report.triangulation_angle, angle);
+  EXPECT_EQ(report.num_exported,
+            static_cast<int>(all.size()) - short_track - error - angle);
+  ASSERT_EQ(kept.size(), static_cast<size_t>(report.num_exported));
+  for (const Landmark& l : kept) {
+    EXPECT_GE(l.num_observations, 12);
+    EXPECT_LE(l.mean_reprojection_error_px, 0.4);
+    EXPECT_GE(l.triangulation_angle_deg, 6.0);
+  }
+  // A NaN quality is never trusted.
+  std::vector<Landmark> nan_point(1, all[0]);
+  nan_point[0].mean_reprojection_error_px = std::nan("");
+  EXPECT_EQ(
+      FilterTrustedPoints(PointTrustOptions{}, &nan_point).reprojection_error,
+      1);
+  EXPECT_TRUE(nan_point.empty());
+}
+
+TEST(PointTrustTest, CheckRejectsBadValues) {
+  EXPECT_NO_THROW(PointTrustOptions{}.Check());
+  auto error_of = [](const PointTrustOptions& o) -> std::string {
+    try {
+      o.Check();
+    } catch (const OptionsError& e) {
+      return e.what();
+    }
+    return "";
+  };
+  PointTrustOptions o;
+  o.min_track_length = 1;
+  EXPECT_NE(error_of(o).find("min_track_length"), std::string::npos);
+  o = {};
+  o.max_mean_reprojection_error_px = 0.0;
+  EXPECT_NE(error_of(o).find("max_mean_reprojection_error_px"),
+            std::string::npos);
+  o.max_mean_reprojection_error_px = std::nan("");
+  EXPECT_NE(error_of(o).find("max_mean_reprojection_error_px"),
+            std::string::npos);
+  o = {};
+  o.min_triangulation_angle_deg = -0.5;
+  EXPECT_NE(error_of(o).find("min_triangulation_angle_deg"), std::string::npos);
+  o.min_triangulation_angle_deg = 180.0;
+  EXPECT_NE(error_of(o).find("min_triangulation_angle_deg"), std::string::npos);
+  // The filter checks its options before touching the points.
+  std::vector<Landmark> points(3);
+  EXPECT_THROW(FilterTrustedPoints(o, &points), OptionsError);
+  EXPECT_EQ(points.size(), 3u);
+}
+
+}  // namespace
+}  // namespace monomap
