@@ -43,15 +43,16 @@ namespace {
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
-const fs::path kRoot = fs::temp_directory_path() /
-                       ("monomap_ros_e2e_" + std::to_string(getpid()));
+const fs::path kRoot =
+    fs::temp_directory_path() / ("monomap_ros_e2e_" + std::to_string(getpid()));
 // Bag stamps are the simulated ones plus this (ROS time 0 means "latest").
 constexpr double kStampOffset = 1000.0;
 constexpr double kTransformTolerance = 0.1;
 
 bool HaveRosTools() {
-  return std::system("command -v rosmaster >/dev/null && "
-                     "command -v rosbag >/dev/null") == 0;
+  return std::system(
+             "command -v rosmaster >/dev/null && "
+             "command -v rosbag >/dev/null") == 0;
 }
 
 int FreePort() {
@@ -93,7 +94,8 @@ Child Spawn(const std::vector<std::string>& args, const fs::path& log) {
   if (std::freopen(log.c_str(), "w", stdout) == nullptr) _exit(120);
   dup2(fileno(stdout), fileno(stderr));
   std::vector<char*> argv;
-  for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+  for (const std::string& a : args)
+    argv.push_back(const_cast<char*>(a.c_str()));
   argv.push_back(nullptr);
   execvp(argv[0], argv.data());
   _exit(121);
@@ -106,8 +108,8 @@ bool WaitFor(Child* c, double seconds) {
     int status = 0;
     const pid_t r = waitpid(c->pid, &status, WNOHANG);
     if (r == c->pid) {
-      c->exit_code = WIFSIGNALED(status) ? 128 + WTERMSIG(status)
-                                         : WEXITSTATUS(status);
+      c->exit_code =
+          WIFSIGNALED(status) ? 128 + WTERMSIG(status) : WEXITSTATUS(status);
       return true;
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
@@ -129,8 +131,7 @@ bool Stop(Child* c, double seconds = 10.0) {
 
 // Processes left in the group of `c` (pgrep -g).
 int LeftRunning(const Child& c) {
-  const std::string cmd =
-      "pgrep -g " + std::to_string(c.pid) + " | wc -l";
+  const std::string cmd = "pgrep -g " + std::to_string(c.pid) + " | wc -l";
   FILE* p = popen(cmd.c_str(), "r");
   int n = -1;
   if (p) {
@@ -179,7 +180,7 @@ void WriteBag(const Dataset& sim, const fs::path& path) {
 // What the test receives from the node.
 struct Received {
   std::mutex mutex;
-  std::vector<std::pair<double, Rigid3d>> poses;         // stamp, map<-base
+  std::vector<std::pair<double, Rigid3d>> poses;          // stamp, map<-base
   std::vector<std::pair<double, Rigid3d>> map_from_odom;  // tf stamp, T
   std::string status;
 };
@@ -275,8 +276,8 @@ class Listener {
           got->poses.emplace_back(m->header.stamp.toSec(),
                                   ros_adapter::RigidFromMsg(m->pose.pose));
         });
-    tf_sub_ = nh_.subscribe<tf2_msgs::TFMessage>(
-        "/tf", 500, [got](const auto& m) {
+    tf_sub_ =
+        nh_.subscribe<tf2_msgs::TFMessage>("/tf", 500, [got](const auto& m) {
           std::lock_guard<std::mutex> lock(got->mutex);
           for (const auto& t : m->transforms) {
             if (t.header.frame_id == "map" && t.child_frame_id == "odom") {
@@ -337,9 +338,9 @@ void InitRosClient() {
   char arg0[] = "monomap_e2e_listener";
   char* argv[] = {arg0, nullptr};
   int argc = 1;
-  ros::init(argc, argv, "monomap_e2e_listener",
-            ros::init_options::NoSigintHandler |
-                ros::init_options::AnonymousName);
+  ros::init(
+      argc, argv, "monomap_e2e_listener",
+      ros::init_options::NoSigintHandler | ros::init_options::AnonymousName);
 }
 
 Child StartNode(const std::string& name, const fs::path& map_dir,
@@ -348,11 +349,16 @@ Child StartNode(const std::string& name, const fs::path& map_dir,
   // localized whatever the machine's load (real-time figures with one
   // pending frame: bench/realtime_replay).
   std::vector<std::string> args = {
-      MONOMAP_ROS_NODE, "__name:=" + name, "image:=/camera/image_raw",
-      "camera_info:=/camera/camera_info", "_map_dir:=" + map_dir.string(),
-      "_method:=mcc", "_particles:=200",
+      MONOMAP_ROS_NODE,
+      "__name:=" + name,
+      "image:=/camera/image_raw",
+      "camera_info:=/camera/camera_info",
+      "_map_dir:=" + map_dir.string(),
+      "_method:=mcc",
+      "_particles:=200",
       "_transform_tolerance:=" + std::to_string(kTransformTolerance),
-      "_drop_when_busy:=true", "_max_pending_frames:=100",
+      "_drop_when_busy:=true",
+      "_max_pending_frames:=100",
       "_camera_frame_id:=camera_optical"};
   return Spawn(args, log);
 }
@@ -373,17 +379,17 @@ void SetInitialPose(const std::string& node_name, const Dataset& live) {
   const Eigen::Vector3d& t = world_from_cam.translation;
   const Eigen::Quaterniond& q = world_from_cam.rotation;
   const std::string ns = "/" + node_name + "/";
-  ros::param::set(ns + "init_pose", std::vector<double>{t.x(), t.y(), t.z(),
-                                                        q.x(), q.y(), q.z(),
-                                                        q.w()});
+  ros::param::set(
+      ns + "init_pose",
+      std::vector<double>{t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w()});
   ros::param::set(ns + "init_spread_m", 0.2);
   ros::param::set(ns + "init_spread_deg", 6.0);
 }
 
 // Starts the node on `map_dir`, plays the mount, then the bag at the
 // camera's rate, and stops the node once it has drained its queue.
-void RunNode(const fs::path& map_dir, const fs::path& bag,
-             const Dataset& live, Received* got) {
+void RunNode(const fs::path& map_dir, const fs::path& bag, const Dataset& live,
+             Received* got) {
   const int images = int(live.frames.size());
   Listener listener(got);
   SetInitialPose("monomap_localization", live);
@@ -397,12 +403,12 @@ void RunNode(const fs::path& map_dir, const fs::path& bag,
                        "--topics", "/tf_static", "--", bag.string()},
                       kRoot / "mount.log");
   EXPECT_TRUE(WaitFor(&mount, 60.0)) << ReadAll(kRoot / "mount.log");
-  ASSERT_TRUE(WaitUntil(
-      [&] { return LatestStatus(got).rfind("ready", 0) == 0; }, 60.0))
+  ASSERT_TRUE(
+      WaitUntil([&] { return LatestStatus(got).rfind("ready", 0) == 0; }, 60.0))
       << ReadAll(kRoot / "node.log");
-  Child play = Spawn({"rosbag", "play", "--quiet", "--wait-for-subscribers",
-                      bag.string()},
-                     kRoot / "play.log");
+  Child play = Spawn(
+      {"rosbag", "play", "--quiet", "--wait-for-subscribers", bag.string()},
+      kRoot / "play.log");
   EXPECT_TRUE(WaitFor(&play, 60.0)) << ReadAll(kRoot / "play.log");
   EXPECT_EQ(play.exit_code, 0) << ReadAll(kRoot / "play.log");
   WaitForTheQueueToDrain(got, images);
@@ -428,7 +434,7 @@ std::map<long, size_t> FrameOfStamp(const Dataset& live) {
 constexpr double kLocalizedM = 0.05;
 
 struct PoseErrors {
-  int n = 0;         // poses received
+  int n = 0;          // poses received
   int localized = 0;  // of them, within kLocalizedM
   double median_m = 0, worst_m = 0, median_deg = 0, worst_deg = 0;
 };
@@ -480,11 +486,11 @@ int CheckTfTree(const Dataset& live, const Received& got) {
     if (p == pose_at.end() || !frame_of.count(key)) continue;
     const Rigid3d composed =
         world_from_odom * OdomFromBase(live.frames[frame_of.at(key)]);
-    worst_m = std::max(
-        worst_m, (composed.translation - p->second.translation).norm());
-    worst_deg = std::max(
-        worst_deg,
-        RadToDeg(AngleBetween(composed.rotation, p->second.rotation)));
+    worst_m = std::max(worst_m,
+                       (composed.translation - p->second.translation).norm());
+    worst_deg =
+        std::max(worst_deg,
+                 RadToDeg(AngleBetween(composed.rotation, p->second.rotation)));
     ++matched;
   }
   EXPECT_LT(worst_m, 1e-3);
@@ -538,16 +544,16 @@ TEST_F(RosNodeE2e, LocalizesASecondTraversalOnABuiltMap) {
       "ros e2e: %d poses of %d frames, %d within %.0f mm (%.0f%%) on a built "
       "map; position median %.1f mm, worst %.1f mm; heading median %.2f deg, "
       "worst %.2f deg; tf: %d matched; status '%s'; %.1f s\n",
-      e.n, kLiveFrames, e.localized, 1e3 * kLocalizedM,
-      100.0 * localized_share, 1e3 * e.median_m, 1e3 * e.worst_m, e.median_deg,
-      e.worst_deg, matched, got.status.c_str(), seconds);
+      e.n, kLiveFrames, e.localized, 1e3 * kLocalizedM, 100.0 * localized_share,
+      1e3 * e.median_m, 1e3 * e.worst_m, e.median_deg, e.worst_deg, matched,
+      got.status.c_str(), seconds);
 }
 
 // A map directory that does not load: one fatal message naming it, exit
 // code 1, no crash.
 TEST_F(RosNodeE2e, ABadMapExitsWithOneFatalMessage) {
-  Child node = StartNode("monomap_bad_map", kRoot / "no_such_map",
-                         kRoot / "bad.log");
+  Child node =
+      StartNode("monomap_bad_map", kRoot / "no_such_map", kRoot / "bad.log");
   ASSERT_TRUE(WaitFor(&node, 30.0)) << ReadAll(kRoot / "bad.log");
   const std::string log = ReadAll(kRoot / "bad.log");
   EXPECT_EQ(node.exit_code, 1) << log;
