@@ -15,16 +15,9 @@ using testing::OdometryDriftOptions;
 using testing::SimulateOdometryDrift;
 using testing::SyntheticCamera;
 
-// TestSceneOptions of the kPoints layout, flat (see PointLayoutOptions).
-struct SyntheticSceneOptions {
+// TestSceneOptions of the kPoints layout, flat.
+struct SyntheticSceneOptions : testing::PointLayoutOptions {
   int num_frames = 60;
-  double step_m = 0.003;
-  int num_tracks = 500;
-  int min_track_length = 10;
-  int max_track_length = 50;
-  double min_depth_m = 0.3;
-  double max_depth_m = 0.6;
-  double pixel_noise_px = 0.0;
   uint64_t seed = 1;
   std::optional<Camera> camera;
 };
@@ -42,9 +35,7 @@ inline SyntheticScene MakeSyntheticScene(const SyntheticSceneOptions& o) {
   t.num_frames = o.num_frames;
   t.seed = o.seed;
   t.camera = o.camera;
-  t.points = {o.step_m,           o.num_tracks,  o.min_track_length,
-              o.max_track_length, o.min_depth_m, o.max_depth_m,
-              o.pixel_noise_px};
+  t.points = o;  // the PointLayoutOptions part
   testing::TestScene s = testing::MakeTestScene(t);
   return {s.camera, std::move(s.world_from_cam), std::move(s.points),
           std::move(s.tracks)};
