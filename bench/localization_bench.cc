@@ -1,29 +1,43 @@
 // One update of the localization filter on the synthetic room of
-// sim/room_scene.h (floor + 4 walls, 320x240 live camera with
+// sim/test_scene.h (kRoom: floor + 4 walls, 320x240 live camera with
 // distortion): predict + render (80x60) + weigh + resample for MCL with a
 // fixed count of 1000 particles, and the same plus Monte Carlo Correction
 // of the 8 heaviest particles (160x120 renders, KLT, PnP) and merging for
 // MCC. Also the parts: scoring 1000 renders, one MCC correction.
 //
 //   build-loc/bench/localization_bench --benchmark_counters_tabular=true
-#include <vector>
-
 #include <benchmark/benchmark.h>
 
+#include <vector>
+
 #include "monomap/localization/localizer.h"
-#include "monomap/sim/room_scene.h"
+#include "monomap/sim/test_scene.h"
 
 namespace monomap {
 namespace {
 
+// The room seen from one base pose, with its live image.
+testing::TestScene RoomView(const Pose2d& base) {
+  testing::TestSceneOptions o;
+  o.layout = testing::TestLayout::kRoom;
+  o.seed = 1;
+  o.room.base_poses = {base};
+  o.room.render_images = true;
+  o.room.gain = 0.8;
+  o.room.offset = 15;
+  o.room.noise_sigma = 2.0;
+  return testing::MakeTestScene(o);
+}
+
 struct Scene {
-  Map map = testing::RoomMap();
-  Camera camera = testing::LiveCamera();
-  Rigid3d mount = testing::BaseFromCam();
-  Renderer renderer{map};
   Pose2d base{0.5, 0.2, 0.4};
-  Rigid3d truth = WorldFromCamOfBase(base, mount);
-  cv::Mat live = testing::LiveImage(renderer, camera, truth, 0.8, 15, 2.0, 1);
+  testing::TestScene view = RoomView(base);
+  const Map& map = view.map;
+  const Camera& camera = view.camera;
+  const Rigid3d& mount = view.base_from_cam;
+  Renderer renderer{map};
+  const Rigid3d& truth = view.world_from_cam[0];
+  const cv::Mat& live = view.images[0];
 };
 
 const Scene& GetScene() {
@@ -66,9 +80,14 @@ void BM_MclUpdate(benchmark::State& state) {
 void BM_MccUpdate(benchmark::State& state) {
   BM_Update(state, LocalizationMethod::kMcc);
 }
-BENCHMARK(BM_MclUpdate)->Arg(1000)->Unit(benchmark::kMillisecond)
+BENCHMARK(BM_MclUpdate)
+    ->Arg(1000)
+    ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
-BENCHMARK(BM_MccUpdate)->Arg(1000)->Arg(200)->Unit(benchmark::kMillisecond)
+BENCHMARK(BM_MccUpdate)
+    ->Arg(1000)
+    ->Arg(200)
+    ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
 // Rendering + NCC of 1000 poses (parallel), without the filter around it.
@@ -87,7 +106,9 @@ void BM_ScoreBatch(benchmark::State& state) {
     benchmark::DoNotOptimize(model.ScoreBatch(live, poses).data());
   }
 }
-BENCHMARK(BM_ScoreBatch)->Arg(1000)->Unit(benchmark::kMillisecond)
+BENCHMARK(BM_ScoreBatch)
+    ->Arg(1000)
+    ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
 // One render + NCC on the calling thread (the per-particle cost).

@@ -3,16 +3,16 @@
 // camera, 40 frames blended. Images are ray-cast on demand (outside the
 // timed region: they are rendered once and cached before timing).
 //   build-texture/bench/texture_bench
+#include <benchmark/benchmark.h>
+
 #include <cstdio>
 #include <map>
 #include <memory>
 #include <mutex>
 
-#include <benchmark/benchmark.h>
-
+#include "monomap/sim/test_scene.h"
 #include "monomap/texture/image_plane_homography.h"
 #include "monomap/texture/mosaic.h"
-#include "monomap/sim/textured_plane_scene.h"
 
 namespace monomap {
 namespace {
@@ -36,7 +36,26 @@ struct BenchScene {
     camera.cx = 367.2;
     camera.cy = 248.4;
     camera.distortion = {-0.28, 0.074, 0.0002, 0.00002, 0.0};
-    // A hand-held sweep over a desk: 300 frames at 0.45-0.6 m.
+    testing::TestSceneOptions o;
+    o.layout = testing::TestLayout::kDesk;
+    o.camera = camera;
+    o.world_from_cam = DeskSweep();
+    o.desk.num_features = 300;
+    o.desk.feature_seed = 1;
+    o.desk.texture_seed = 2;
+    o.desk.texture_blobs = 60;
+    testing::TestScene t = testing::MakeTestScene(o);
+    poses = std::move(t.world_from_cam);
+    segments = std::move(t.segments);
+    landmarks = std::move(t.landmarks);
+    tracks = std::move(t.tracks);
+    planes = std::move(t.planes);
+    caster = std::make_unique<testing::RayCaster>(camera, 1);
+  }
+
+  // A hand-held sweep over a desk: 300 frames at 0.45-0.6 m.
+  static std::vector<Rigid3d> DeskSweep() {
+    std::vector<Rigid3d> poses;
     for (int i = 0; i < 300; ++i) {
       const double a = 6.283185307179586 * i / 300;
       const Eigen::Vector3d eye(0.3 + 0.2 * std::cos(a),
@@ -46,17 +65,7 @@ struct BenchScene {
                                    0.2 + 0.03 * std::sin(a), 0.0);
       poses.push_back(testing::LookAt(eye, target, Eigen::Vector3d::UnitY()));
     }
-    PlaneSegment desk =
-        testing::HorizontalRectangle(0, 0.0, 0.0, 0.0, 0.6, 0.4);
-    testing::MakePlaneFeatures(camera, poses, 300, 0, 1, &desk, &landmarks,
-                               &tracks);
-    segments.push_back(desk);
-    const auto texture = testing::ProceduralTexture::Make(
-        2, {0.0, 0.0}, {0.6, 0.4}, 60);
-    planes.push_back({desk, [texture](int, const Eigen::Vector2d& st) {
-                        return texture(st);
-                      }});
-    caster = std::make_unique<testing::RayCaster>(camera, 1);
+    return poses;
   }
 
   // Rendered on first use; the mosaic calls this from several threads.
@@ -65,9 +74,9 @@ struct BenchScene {
     auto it = images.find(f);
     if (it == images.end()) {
       it = images
-               .emplace(f, caster->Render(poses[f], planes, f,
-                                          0.85 + 0.3 * ((f * 7) % 13) / 12.0,
-                                          2.0))
+               .emplace(f,
+                        caster->Render(poses[f], planes, f,
+                                       0.85 + 0.3 * ((f * 7) % 13) / 12.0, 2.0))
                .first;
     }
     return it->second;
@@ -102,14 +111,14 @@ void BM_Mosaic(benchmark::State& state) {
   options.max_frames_per_plane = 40;
   // Render the blended frames once, outside the timing.
   std::vector<TexturedPlane> planes;
-  BuildTexturedPlanes(s.camera, s.poses, s.segments, s.landmarks, s.tracks,
-                      hs, [&](int f) { return s.Image(f); }, options, &planes);
+  BuildTexturedPlanes(
+      s.camera, s.poses, s.segments, s.landmarks, s.tracks, hs,
+      [&](int f) { return s.Image(f); }, options, &planes);
   MosaicReport report;
   for (auto _ : state) {
-    report = BuildTexturedPlanes(s.camera, s.poses, s.segments, s.landmarks,
-                                 s.tracks, hs,
-                                 [&](int f) { return s.Image(f); }, options,
-                                 &planes);
+    report = BuildTexturedPlanes(
+        s.camera, s.poses, s.segments, s.landmarks, s.tracks, hs,
+        [&](int f) { return s.Image(f); }, options, &planes);
   }
   const auto& p = report.planes.at(0);
   state.counters["ppm"] = p.pixels_per_meter;

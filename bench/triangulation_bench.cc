@@ -3,14 +3,14 @@
 // length 30, 0.3 px noise, drifting odometry.
 //
 //   build-triangulation/bench/triangulation_bench
+#include <benchmark/benchmark.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
 
-#include <benchmark/benchmark.h>
-
+#include "monomap/sim/test_scene.h"
 #include "monomap/triangulation/bundle_adjustment.h"
-#include "monomap/sim/synthetic_scene.h"
 #include "monomap/triangulation/triangulator.h"
 #include "monomap/util/angles.h"
 #include "monomap/util/stats.h"
@@ -19,7 +19,7 @@ namespace monomap {
 namespace {
 
 struct Problem {
-  SyntheticScene scene;
+  testing::TestScene scene;
   std::vector<Rigid3d> odometry;
   std::vector<Landmark> landmarks;  // triangulated with the odometry
 };
@@ -27,15 +27,16 @@ struct Problem {
 const Problem& GetProblem() {
   static const Problem problem = [] {
     Problem p;
-    SyntheticSceneOptions options;
+    testing::TestSceneOptions options;
+    options.layout = testing::TestLayout::kPoints;
     options.num_frames = 300;
-    options.num_tracks = 8000;
-    options.min_track_length = 10;
-    options.max_track_length = 50;
-    options.pixel_noise_px = 0.3;
-    p.scene = MakeSyntheticScene(options);
-    p.odometry =
-        SimulateOdometryDrift(p.scene.world_from_cam, OdometryDriftOptions());
+    options.points.num_tracks = 8000;
+    options.points.min_track_length = 10;
+    options.points.max_track_length = 50;
+    options.points.pixel_noise_px = 0.3;
+    p.scene = testing::MakeTestScene(options);
+    p.odometry = testing::SimulateOdometryDrift(
+        p.scene.world_from_cam, testing::OdometryDriftOptions());
     TriangulateTracks(p.scene.camera, p.odometry, p.scene.tracks,
                       TriangulationOptions(), &p.landmarks);
     return p;
@@ -77,8 +78,8 @@ void BM_BundleAdjust(benchmark::State& state) {
     std::vector<Rigid3d> poses = p.odometry;
     std::vector<Landmark> landmarks = p.landmarks;
     state.ResumeTiming();
-    report =
-        BundleAdjust(p.scene.camera, p.scene.tracks, options, &poses, &landmarks);
+    report = BundleAdjust(p.scene.camera, p.scene.tracks, options, &poses,
+                          &landmarks);
     benchmark::DoNotOptimize(landmarks.data());
   }
   // Accuracy against the truth (the first pose is shared, so no alignment).
@@ -96,8 +97,7 @@ void BM_BundleAdjust(benchmark::State& state) {
     auto mean_rotation_error = [&](const std::vector<Rigid3d>& ps) {
       double sum = 0.0;
       for (size_t i = 0; i < ps.size(); ++i) {
-        sum += AngleBetween(ps[i].rotation,
-                            p.scene.world_from_cam[i].rotation);
+        sum += AngleBetween(ps[i].rotation, p.scene.world_from_cam[i].rotation);
       }
       return RadToDegMulDiv(sum / ps.size());
     };

@@ -4,22 +4,23 @@
 
 #include <cmath>
 
-#include "monomap/sim/synthetic_scene.h"
+#include "monomap/sim/test_scene.h"
 
 namespace monomap {
 namespace {
 
-SyntheticScene Scene() {
-  SyntheticSceneOptions options;
-  options.num_tracks = 600;
+testing::TestScene Scene() {
+  testing::TestSceneOptions options;
+  options.layout = testing::TestLayout::kPoints;
+  options.points.num_tracks = 600;
   options.num_frames = 80;
-  options.pixel_noise_px = 0.1;
+  options.points.pixel_noise_px = 0.1;
   options.seed = 5;
-  return MakeSyntheticScene(options);
+  return testing::MakeTestScene(options);
 }
 
 TEST(LensResiduals, RightCalibrationLeavesNoRadialOffset) {
-  const SyntheticScene scene = Scene();
+  const testing::TestScene scene = Scene();
   const LensResidualReport report = EvaluateLensResiduals(
       scene.camera, scene.world_from_cam, scene.tracks, {});
   EXPECT_GT(report.tracks_used, 100);
@@ -32,7 +33,7 @@ TEST(LensResiduals, RightCalibrationLeavesNoRadialOffset) {
 }
 
 TEST(LensResiduals, WeakerBarrelShowsAsAnInwardOffsetGrowingToTheRim) {
-  const SyntheticScene scene = Scene();
+  const testing::TestScene scene = Scene();
   Camera wrong = scene.camera;
   wrong.distortion[0] += 0.02;  // the true lens bends more than this one
   const LensResidualReport report =

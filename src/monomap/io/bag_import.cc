@@ -12,6 +12,7 @@
 #include "monomap/io/dataset_writer.h"
 #include "monomap/io/image_file.h"
 #include "monomap/io/trajectory_io.h"
+#include "monomap/util/angles.h"
 #include "monomap/util/error.h"
 #include "monomap/util/file.h"
 
@@ -399,7 +400,7 @@ void ImportImage(const Image& msg, ImportState& s) {
   f.image = name + image.extension;
   f.odometry_world_from_cam = world_from_base * s.base_from_cam;
   f.odometry_base =
-      PlanarPose(world_from_base, s.options.max_planar_tilt_deg * M_PI / 180,
+      PlanarPose(world_from_base, DegToRadMulDiv(s.options.max_planar_tilt_deg),
                  s.options.max_planar_height_m);
   WriteFileAtomic(s.dir / f.image,
                   std::string(image.encoded.begin(), image.encoded.end()));

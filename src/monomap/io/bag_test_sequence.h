@@ -17,6 +17,7 @@
 #include "monomap/geometry/rigid3.h"
 #include "monomap/io/bag_import.h"
 #include "monomap/io/dataset.h"
+#include "monomap/util/angles.h"
 #include "monomap/util/error.h"
 #include "monomap/util/file.h"
 
@@ -54,7 +55,7 @@ inline Rigid3d BaseAt(double t) {
 // tilted 10 degrees down, optical axes (z forward, x right, y down).
 inline Rigid3d BaseFromCameraLink() {
   return Rigid3d(Eigen::Quaterniond(Eigen::AngleAxisd(
-                     10 * M_PI / 180, Eigen::Vector3d::UnitY())),
+                     DegToRadMulDiv(10), Eigen::Vector3d::UnitY())),
                  Eigen::Vector3d(0.2, 0.0, 0.5));
 }
 inline Rigid3d CameraLinkFromOptical() {

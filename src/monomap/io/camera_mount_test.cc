@@ -4,6 +4,7 @@
 
 #include <sstream>
 
+#include "monomap/util/angles.h"
 #include "monomap/util/error.h"
 
 namespace monomap {
@@ -13,8 +14,8 @@ namespace {
 // 20 degrees and yawed 5 degrees, 0.3 m above the base.
 Rigid3d TestMount() {
   const Eigen::Quaterniond optical_from_forward =
-      Eigen::AngleAxisd(5 * M_PI / 180, Eigen::Vector3d::UnitZ()) *
-      Eigen::AngleAxisd(-M_PI / 2 - 20 * M_PI / 180, Eigen::Vector3d::UnitX()) *
+      Eigen::AngleAxisd(DegToRadMulDiv(5), Eigen::Vector3d::UnitZ()) *
+      Eigen::AngleAxisd(-M_PI / 2 - DegToRadMulDiv(20), Eigen::Vector3d::UnitX()) *
       Eigen::AngleAxisd(0.0, Eigen::Vector3d::UnitY());
   return Rigid3d(optical_from_forward, Eigen::Vector3d(0.12, -0.03, 0.31));
 }

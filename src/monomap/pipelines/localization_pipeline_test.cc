@@ -8,13 +8,12 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "monomap/io/map_format.h"
-#include "monomap/sim/room_scene.h"
+#include "monomap/sim/test_scene.h"
+#include "monomap/util/angles.h"
 #include "monomap/util/error.h"
 
 namespace monomap {
 namespace {
-
-constexpr double kDeg = M_PI / 180.0;
 
 // Composes a planar motion (forward, turn) given in the base frame.
 Pose2d Forward(const Pose2d& a, double fwd, double turn) {
@@ -31,29 +30,37 @@ class LocalizationPipelineTest : public ::testing::Test {
     dir_ = std::filesystem::temp_directory_path() /
            ("monomap_localization_pipeline_test_" + std::to_string(::getpid()));
     std::filesystem::create_directories(dir_);
-    map_ = testing::RoomMap();
-    const Camera camera = testing::LiveCamera();
-    const Rigid3d mount = testing::BaseFromCam();
-    const Renderer renderer(map_);
+    testing::TestSceneOptions o;
+    o.layout = testing::TestLayout::kRoom;
+    o.seed = 0;  // image noise seeded by the frame index
+    o.room.render_images = true;
+    o.room.gain = 0.9;
+    o.room.offset = 5;
+    o.room.noise_sigma = 2.0;
+    Pose2d truth{0.0, 0.3, -0.2};
+    for (int i = 0; i < 10; ++i) {
+      o.room.base_poses.push_back(truth);
+      truth = Forward(truth, 0.03, DegToRad(1.0));
+    }
+    const testing::TestScene scene = testing::MakeTestScene(o);
+    map_ = scene.map;
+    truth_ = scene.world_from_cam;
     ds_.root = dir_;
-    ds_.camera = camera;
-    ds_.base_from_cam = mount;
+    ds_.camera = scene.camera;
+    ds_.base_from_cam = scene.base_from_cam;
     ds_.has_groundtruth = true;
-    Pose2d truth{0.0, 0.3, -0.2}, odometry{0, 0, 0};
+    Pose2d odometry{0, 0, 0};
     for (int i = 0; i < 10; ++i) {
       DatasetFrame f;
       f.timestamp = 0.1 * i;
       f.image_path = dir_ / ("f" + std::to_string(i) + ".png");
-      truth_.push_back(WorldFromCamOfBase(truth, mount));
-      cv::imwrite(f.image_path.string(),
-                  testing::LiveImage(renderer, camera, truth_.back(), 0.9, 5,
-                                        2.0, i));
+      cv::imwrite(f.image_path.string(), scene.images[i]);
       f.odometry_base = odometry;
-      f.odometry_world_from_cam = WorldFromCamOfBase(odometry, mount);
-      f.groundtruth_world_from_cam = truth_.back();
+      f.odometry_world_from_cam =
+          WorldFromCamOfBase(odometry, scene.base_from_cam);
+      f.groundtruth_world_from_cam = truth_[i];
       ds_.frames.push_back(f);
-      truth = Forward(truth, 0.03, 1.0 * kDeg);
-      odometry = Forward(odometry, 0.03 * 1.05, 1.1 * kDeg);
+      odometry = Forward(odometry, 0.03 * 1.05, DegToRad(1.1));
     }
   }
   void TearDown() override { std::filesystem::remove_all(dir_); }

@@ -6,7 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "monomap/geometry/homography.h"
-#include "monomap/sim/textured_plane_scene.h"
+#include "monomap/sim/test_scene.h"
 #include "monomap/util/error.h"
 
 namespace monomap {
@@ -40,24 +40,19 @@ std::vector<Rigid3d> TestPoses(int n) {
 // One 0.6 x 0.4 m plane at z = 0 (segment id `plane_id`) seen by `frames`
 // cameras, with `count` features (ids from `first_id`) observed from the
 // true poses.
-struct OnePlaneScene {
-  Camera camera = TestCamera();
-  std::vector<Rigid3d> poses;
-  std::vector<PlaneSegment> segments;
-  std::vector<Landmark> landmarks;
-  std::vector<Track> tracks;
-};
+using OnePlaneScene = testing::TestScene;
 
 OnePlaneScene MakeOnePlaneScene(int frames, int plane_id, int count,
                                 FeatureId first_id, uint32_t seed) {
-  OnePlaneScene scene;
-  scene.poses = TestPoses(frames);
-  scene.segments = {
-      testing::HorizontalRectangle(plane_id, 0.0, 0.0, 0.0, 0.6, 0.4)};
-  testing::MakePlaneFeatures(scene.camera, scene.poses, count, first_id, seed,
-                             &scene.segments[0], &scene.landmarks,
-                             &scene.tracks);
-  return scene;
+  testing::TestSceneOptions o;
+  o.layout = testing::TestLayout::kDesk;
+  o.camera = TestCamera();
+  o.world_from_cam = TestPoses(frames);
+  o.desk.plane_id = plane_id;
+  o.desk.num_features = count;
+  o.desk.first_feature_id = first_id;
+  o.desk.feature_seed = seed;
+  return testing::MakeTestScene(o);
 }
 
 // The homographies of `scene` for the given poses (the true ones or not).
@@ -74,7 +69,7 @@ TEST(ImagePlaneHomographyTest, MatchesAnalyticProjectionForExactPoses) {
   const OnePlaneScene scene = MakeOnePlaneScene(10, 3, 50, 100, 7);
   std::vector<ImagePlaneHomography> hs;
   const HomographyReport report =
-      ComputeFor(scene, scene.poses, HomographyOptions(), &hs);
+      ComputeFor(scene, scene.world_from_cam, HomographyOptions(), &hs);
   ASSERT_EQ(report.num_homographies, 10);
   EXPECT_EQ(report.num_checked, 10);
   EXPECT_EQ(report.num_refined, 0);
@@ -91,7 +86,7 @@ TEST(ImagePlaneHomographyTest, MatchesAnalyticProjectionForExactPoses) {
     EXPECT_FALSE(h.refined);
     // Plane resolution is about f / height.
     EXPECT_NEAR(h.pixels_per_meter, 280.0 / 0.5, 150.0);
-    const Rigid3d cam_from_world = scene.poses[h.frame].Inverse();
+    const Rigid3d cam_from_world = scene.world_from_cam[h.frame].Inverse();
     double max_err = 0.0;
     for (int i = 0; i < 100; ++i) {
       const Eigen::Vector2d st(0.6 * u(rng), 0.4 * u(rng));
@@ -108,7 +103,7 @@ TEST(ImagePlaneHomographyTest, MatchesAnalyticProjectionForExactPoses) {
 TEST(ImagePlaneHomographyTest, RefinesWhenPoseIsOff) {
   // Observations from the true poses, homographies from perturbed ones.
   const OnePlaneScene scene = MakeOnePlaneScene(8, 0, 60, 0, 3);
-  std::vector<Rigid3d> wrong = scene.poses;
+  std::vector<Rigid3d> wrong = scene.world_from_cam;
   for (size_t i = 0; i < wrong.size(); ++i) {
     wrong[i] =
         wrong[i] * Rigid3d(QuaternionFromRotationVector({0.008, -0.006, 0.004}),
@@ -144,14 +139,14 @@ TEST(ImagePlaneHomographyTest, IgnoresParallaxOfLandmarksOffThePlane) {
   // the plane's.
   PlaneSegment raised =
       testing::HorizontalRectangle(0, 0.0, 0.0, 0.015, 0.6, 0.4);
-  testing::MakePlaneFeatures(scene.camera, scene.poses, 80, 1000, 4, &raised,
+  testing::MakePlaneFeatures(scene.camera, scene.world_from_cam, 80, 1000, 4, &raised,
                              &scene.landmarks, &scene.tracks);
   for (FeatureId id : raised.inlier_ids)
     scene.segments[0].inlier_ids.push_back(id);
 
   std::vector<ImagePlaneHomography> hs;
   const HomographyReport report =
-      ComputeFor(scene, scene.poses, HomographyOptions(), &hs);
+      ComputeFor(scene, scene.world_from_cam, HomographyOptions(), &hs);
   ASSERT_EQ(report.num_homographies, 10);
   EXPECT_EQ(report.num_refined, 0);
   EXPECT_LT(report.median_residual_before_px, 1e-6);
@@ -167,7 +162,7 @@ TEST(ImagePlaneHomographyTest, IgnoresParallaxOfLandmarksOffThePlane) {
   // 0.5 m) looks like a homography error and triggers refinement.
   HomographyOptions all;
   all.max_feature_parallax_px = 1e9;
-  const HomographyReport r2 = ComputeFor(scene, scene.poses, all, &hs);
+  const HomographyReport r2 = ComputeFor(scene, scene.world_from_cam, all, &hs);
   EXPECT_GT(r2.median_residual_before_px, 1.0);
   EXPECT_GT(r2.num_refined, 0);
 }

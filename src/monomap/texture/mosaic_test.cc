@@ -6,7 +6,7 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
-#include "monomap/sim/textured_plane_scene.h"
+#include "monomap/sim/test_scene.h"
 #include "monomap/util/error.h"
 
 namespace monomap {
@@ -61,22 +61,27 @@ struct Scene {
   }
 };
 
+// A 0.6 x 0.4 m textured floor with 60 features.
 Scene MakeScene(int num_frames) {
-  Scene s;
-  s.poses = TestPoses(num_frames);
-  PlaneSegment floor = testing::HorizontalRectangle(0, 0.0, 0.0, 0.0, 0.6, 0.4);
-  // Move the frame origin away from the polygon's min corner so that the
+  testing::TestSceneOptions o;
+  o.layout = testing::TestLayout::kDesk;
+  o.camera = TestCamera();
+  o.world_from_cam = TestPoses(num_frames);
+  // The frame origin away from the polygon's min corner, so that the
   // mosaic has to shift it.
-  floor.frame.origin = Eigen::Vector3d(-0.1, -0.05, 0.0);
-  for (auto& v : floor.polygon) v += Eigen::Vector2d(0.1, 0.05);
-  testing::MakePlaneFeatures(s.camera, s.poses, 60, 0, 11, &floor,
-                             &s.landmarks, &s.tracks);
-  s.segments.push_back(floor);
-  const auto texture = testing::ProceduralTexture::Make(
-      5, {0.0, 0.0}, {0.7, 0.45}, 25);
-  s.planes.push_back({floor, [texture](int, const Eigen::Vector2d& st) {
-                        return texture(st);
-                      }});
+  o.desk.origin_shift_m = {0.1, 0.05};
+  o.desk.num_features = 60;
+  o.desk.feature_seed = 11;
+  o.desk.texture_seed = 5;
+  o.desk.texture_blobs = 25;
+  o.desk.texture_extent_m = {0.7, 0.45};
+  testing::TestScene t = testing::MakeTestScene(o);
+  Scene s;
+  s.poses = std::move(t.world_from_cam);
+  s.planes = std::move(t.planes);
+  s.segments = std::move(t.segments);
+  s.landmarks = std::move(t.landmarks);
+  s.tracks = std::move(t.tracks);
   return s;
 }
 
