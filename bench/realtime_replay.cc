@@ -52,6 +52,9 @@ struct ReplayArgs {
   int threads = 1;
   // Frames allowed to wait for the filter.
   int max_pending = SessionOptions().max_pending_frames;
+  // MccOptions::converged_px of the estimate's refinement (0: off, the
+  // default): the opt-in early stop, to measure its latency.
+  double refine_converged_px = 0.0;
 };
 
 double ProcessCpuSeconds() {
@@ -97,6 +100,7 @@ SessionOptions MakeOptions(const ReplayArgs& a) {
   o.localizer.seed = a.seed;
   o.max_pending_frames = a.max_pending;
   o.output_particles = false;
+  o.localizer.mcc.refinement.converged_px = a.refine_converged_px;
   return o;
 }
 
@@ -197,6 +201,7 @@ int Run(const ReplayArgs& a) {
   j["state"] = a.state;
   j["init"] = a.init;
   j["threads"] = a.threads;
+  j["refine_converged_px"] = a.refine_converged_px;
   std::printf("%s\n", j.dump(2).c_str());
   if (!a.out.empty()) WriteFileAtomic(a.out, j.dump(2) + "\n");
   return 0;
@@ -225,6 +230,10 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--threads", a.threads)->capture_default_str();
   app.add_option("--max-pending", a.max_pending)->capture_default_str();
+  app.add_option("--refine-converged-px", a.refine_converged_px,
+                 "Stop the estimate's refinement after a round moving less "
+                 "than this (px; 0: off)")
+      ->capture_default_str();
   return monomap::ParseAndRunSweep(app, argc, argv, "realtime_replay",
                                    [&] { return monomap::Run(a); });
 }
