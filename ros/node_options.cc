@@ -84,6 +84,8 @@ void ReadLocalizerOptions(const ros::NodeHandle& pnh, LocalizerOptions* o) {
     }
     o->mcc.refinement.width = refine_width;
   }
+  pnh.param("refine_converged_px", o->mcc.refinement.converged_px,
+            o->mcc.refinement.converged_px);
   int seed = int(o->seed);
   pnh.param("seed", seed, seed);
   o->seed = uint64_t(seed);

@@ -57,6 +57,12 @@ void AddFilterOptions(CLI::App* cmd, LocalizeArgs* a) {
                   "MCC: width of the render the estimate is refined against "
                   "(default: the camera's, up to 1024; 0: no refinement)")
       ->check(CLI::Range(0, 100000));
+  cmd->add_option("--refine-converged-px", o.mcc.refinement.converged_px,
+                  "MCC: stop the estimate's refinement after a round that "
+                  "moved its inliers less than this (px; 0: never). 0.5 "
+                  "saves about a quarter of an update (docs/benchmarks.md)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   cmd->add_option("--relocalize-ncc-drop", o.recovery.relocalize_ncc_drop,
                   "Inject particles over the area when the best particle's "
                   "NCC drops this far below its long-term average (0: never)")
