@@ -2,7 +2,7 @@
 
 #include <gtest/gtest.h>
 
-#include "monomap/sim/room_scene.h"
+#include "monomap/sim/test_scene.h"
 #include "monomap/util/error.h"
 
 namespace monomap {

@@ -9,7 +9,7 @@
 
 #include "monomap/localization/measurement_model.h"
 #include "monomap/localization/particle_filter.h"
-#include "monomap/sim/room_scene.h"
+#include "monomap/sim/test_scene.h"
 
 namespace monomap {
 namespace {
