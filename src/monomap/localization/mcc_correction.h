@@ -47,9 +47,8 @@ struct MccCorrectionOptions {
     // The estimate is near the truth already; a deeper pyramid lets
     // tracks at the map's silhouette run off (see MccOptions::klt_levels).
     o.klt_levels = 2;
-    // converged_px 0.5 (stop after a round that moved < 0.5 px) saves a
-    // third of a desk update but moves the desk's errors (+0.1 mm,
-    // -0.005 deg; docs/benchmarks.md, "Speed per update"): opt-in.
+    // converged_px stays 0: stopping early saves time but costs 6-DoF
+    // accuracy (docs/design-notes.md, "Localization"); opt-in.
     return o;
   }();
   // Particles closer than this after resampling are merged (m, deg).
