@@ -51,14 +51,32 @@ Assignment AssignToTruth(const std::vector<TexturedPlane>& truth,
   return best;
 }
 
-// Angle between the normals (orientation ignored) and offset difference of
-// a fitted plane and a true plane.
-void ComparePlanes(const Plane& fitted, const Plane& truth, double* angle_deg,
-                   double* offset_m) {
-  const double sign = fitted.normal.dot(truth.normal) < 0 ? -1.0 : 1.0;
-  *angle_deg = RadToDeg(
-      std::acos(std::clamp(sign * fitted.normal.dot(truth.normal), -1.0, 1.0)));
-  *offset_m = std::abs(sign * fitted.offset - truth.offset);
+// A fitted plane and the centre of its extent, in the truth's frame.
+struct FittedPlane {
+  Plane plane;
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();
+};
+
+// The centre is the centroid of the polygon (the frame's origin without
+// one), projected on the plane in case the frame is off it.
+FittedPlane FittedInTruth(const TexturedPlane& fitted,
+                          const Rigid3d& truth_from_map) {
+  const Eigen::Vector3d c =
+      fitted.frame.ToWorld(PolygonCentroid(fitted.polygon));
+  return {fitted.plane.Transformed(truth_from_map),
+          truth_from_map * fitted.plane.Project(c)};
+}
+
+// Angle between the normals (orientation ignored), and the offset: the
+// distance of the fitted plane's centre to the true plane. Measured where
+// the plane is, not as the difference of the offsets at the world origin,
+// which grows with the plane's distance from the origin: a wall 8 m away
+// tilted by 0.4 deg differs there by 5.6 cm.
+void ComparePlanes(const FittedPlane& fitted, const Plane& truth,
+                   double* angle_deg, double* offset_m) {
+  const double cos_angle = std::abs(fitted.plane.normal.dot(truth.normal));
+  *angle_deg = RadToDeg(std::acos(std::clamp(cos_angle, -1.0, 1.0)));
+  *offset_m = std::abs(truth.SignedDistance(fitted.center));
 }
 
 // Assigns every landmark to its true plane (`assignment`), counts the
@@ -102,7 +120,7 @@ void ScorePoints(const Map& map, const Map& truth,
 
 // The true plane most of the fitted plane's inliers lie on, or when none
 // does, the closest one; -1 if there is no true plane. Counts the inliers.
-int BestTruePlane(const TexturedPlane& fitted, const Plane& plane,
+int BestTruePlane(const TexturedPlane& fitted, const FittedPlane& plane,
                   const Map& map, const Map& truth,
                   const std::vector<Assignment>& assignment,
                   const StructureAccuracyOptions& options, int* inliers) {
@@ -155,7 +173,7 @@ int MatchPlanes(const Map& map, const Map& truth, const Rigid3d& truth_from_map,
   for (const TexturedPlane& fitted : map.planes) {
     PlaneMatch m;
     m.fitted_id = fitted.id;
-    const Plane plane = fitted.plane.Transformed(truth_from_map);
+    const FittedPlane plane = FittedInTruth(fitted, truth_from_map);
     const int best = BestTruePlane(fitted, plane, map, truth, assignment,
                                    options, &m.inliers);
     if (best >= 0) {

@@ -155,6 +155,37 @@ TEST(StructureAccuracyTest, TiltedPlaneReportsItsAngle) {
   }
 }
 
+TEST(StructureAccuracyTest, OffsetIsMeasuredWhereThePlaneIs) {
+  const Map truth = Truth();
+  for (double tilt_deg : {1.5, 3.0}) {
+    Map map = ExactMap(truth);
+    // The fitted wall x = 4 turned about the vertical line through its
+    // centre (4, 2, 1.25): at the world origin it is 2 sin(1.5 deg) = 5.2 cm
+    // off, but it passes through the wall where the wall is.
+    const Eigen::Vector3d center(4, 2, 1.25);
+    const double t = DegToRad(tilt_deg);
+    TexturedPlane& wall = map.planes[1];
+    wall.plane.normal = {std::cos(t), std::sin(t), 0};
+    wall.plane.offset = -wall.plane.normal.dot(center);
+    wall.frame = MakePlaneFrame(wall.plane, center, {0, 0, 1});
+    wall.polygon = {{-1, -2}, {1, -2}, {1, 2}, {-1, 2}};
+    const StructureAccuracy a =
+        EvaluateStructure(map, truth, Rigid3d::Identity(), {});
+    const PlaneMatch& m = a.matches[1];
+    EXPECT_EQ(m.true_id, 1);
+    EXPECT_NEAR(m.normal_error_deg, tilt_deg, 1e-9);
+    EXPECT_NEAR(m.offset_error_m, 0.0, 1e-12);
+    EXPECT_EQ(m.matched, tilt_deg <= 2.0);
+    // Moved 5 cm along its normal, the centre is 5 cm off: no match.
+    wall.plane.offset -= 0.05;
+    wall.frame.origin += 0.05 * wall.plane.normal;
+    const StructureAccuracy moved =
+        EvaluateStructure(map, truth, Rigid3d::Identity(), {});
+    EXPECT_NEAR(moved.matches[1].offset_error_m, 0.05 * std::cos(t), 1e-9);
+    EXPECT_FALSE(moved.matches[1].matched);
+  }
+}
+
 TEST(StructureAccuracyTest, OrientationOfTheNormalDoesNotMatter) {
   const Map truth = Truth();
   Map map = ExactMap(truth);

@@ -1,6 +1,7 @@
 #include "monomap/geometry/polygon.h"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 namespace monomap {
@@ -40,6 +41,27 @@ double PolygonArea(const Polygon2d& polygon) {
     a += p.x() * q.y() - q.x() * p.y();
   }
   return 0.5 * a;
+}
+
+Eigen::Vector2d PolygonCentroid(const Polygon2d& polygon) {
+  if (polygon.empty()) return Eigen::Vector2d::Zero();
+  // Relative to the first vertex, so far-off coordinates lose no precision.
+  const Eigen::Vector2d o = polygon.front();
+  double twice_area = 0.0;
+  Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+  for (size_t i = 0, n = polygon.size(); i < n; ++i) {
+    const Eigen::Vector2d p = polygon[i] - o;
+    const Eigen::Vector2d q = polygon[(i + 1) % n] - o;
+    const double cross = p.x() * q.y() - q.x() * p.y();
+    twice_area += cross;
+    sum += cross * (p + q);
+  }
+  if (std::abs(twice_area) > 1e-12 * (1.0 + sum.norm())) {
+    return o + sum / (3.0 * twice_area);
+  }
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  for (const auto& v : polygon) mean += v;
+  return mean / static_cast<double>(polygon.size());
 }
 
 bool PointInPolygon(const Polygon2d& polygon, const Eigen::Vector2d& p) {

@@ -16,6 +16,10 @@ Polygon2d ConvexHull(std::vector<Eigen::Vector2d> points);
 // Signed area (> 0 for counter-clockwise).
 double PolygonArea(const Polygon2d& polygon);
 
+// Area centroid of a simple polygon; the mean of its vertices when its area
+// is zero (fewer than 3 vertices, or collinear ones). Empty: (0, 0).
+Eigen::Vector2d PolygonCentroid(const Polygon2d& polygon);
+
 // Even-odd point-in-polygon test (works for non-convex simple polygons).
 bool PointInPolygon(const Polygon2d& polygon, const Eigen::Vector2d& p);
 

@@ -22,6 +22,22 @@ TEST(Polygon, HullAreaAndInside) {
   EXPECT_EQ(hi, Eigen::Vector2d(2, 2));
 }
 
+TEST(PolygonTest, CentroidOfAreaNotOfVertices) {
+  // The L of three unit squares: centroids (0.5,0.5), (1.5,0.5), (0.5,1.5).
+  const Polygon2d l = {{0, 0}, {2, 0}, {2, 1}, {1, 1}, {1, 2}, {0, 2}};
+  const Eigen::Vector2d c = PolygonCentroid(l);
+  EXPECT_NEAR(c.x(), 2.5 / 3.0, 1e-12);
+  EXPECT_NEAR(c.y(), 2.5 / 3.0, 1e-12);
+  // Clockwise order and a far-off position give the same centroid.
+  Polygon2d far(l.rbegin(), l.rend());
+  for (auto& v : far) v += Eigen::Vector2d(1e4, -1e4);
+  EXPECT_NEAR((PolygonCentroid(far) - c - Eigen::Vector2d(1e4, -1e4)).norm(),
+              0.0, 1e-9);
+  // No area: the mean of the vertices.
+  EXPECT_EQ(PolygonCentroid({{0, 0}, {2, 2}}), Eigen::Vector2d(1, 1));
+  EXPECT_EQ(PolygonCentroid({}), Eigen::Vector2d(0, 0));
+}
+
 }  // namespace
 }  // namespace monomap
 
