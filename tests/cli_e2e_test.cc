@@ -292,6 +292,19 @@ TEST_F(Cli, EvalStructurePrintsTheTableAndWritesJson) {
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("(alignment first-pose)"), std::string::npos)
       << r.output;
+  // The similarity fit of the trajectory: the scale the odometry gave the
+  // map (the simulator's wheel-radius error is 1 %), removed.
+  const fs::path sim3_json = *root_ / "structure_sim3.json";
+  r = RunMonomap(
+      "eval structure " + map.string() + " --structure " +
+      (data / "structure").string() + " --align sim3 --groundtruth " +
+      (data / "groundtruth.txt").string() + " --json " + sim3_json.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::ifstream sim3_in(sim3_json);
+  const nlohmann::json j = nlohmann::json::parse(sim3_in);
+  EXPECT_EQ(j["alignment"], "sim3");
+  EXPECT_NEAR(j["alignment_scale"].get<double>(), 1.0, 0.05);
+  EXPECT_NE(j["alignment_scale"].get<double>(), 1.0);
 }
 
 TEST_F(Cli, EvalStructureErrorsNameThePath) {
@@ -634,9 +647,10 @@ TEST_F(Cli, ExportWritesColmapNavGridAndGlb) {
     observations += p.track.size();
   }
   const double mean_error_px = error_sum / observations;
-  std::printf("COLMAP export of the built map: mean reprojection error "
-              "%.3f px over %zu observations\n",
-              mean_error_px, observations);
+  std::printf(
+      "COLMAP export of the built map: mean reprojection error "
+      "%.3f px over %zu observations\n",
+      mean_error_px, observations);
   EXPECT_LT(mean_error_px, 1.0);
   if (std::system("command -v colmap > /dev/null 2>&1") == 0) {
     const std::string cmd = "colmap model_analyzer --path " +

@@ -25,6 +25,26 @@ void StructureAccuracyOptions::Check() const {
   coverage.Check();
 }
 
+Map ScaledMap(const Map& map, double scale) {
+  Map out = map;
+  for (Landmark& l : out.landmarks) {
+    l.x_in_world *= scale;
+    l.mean_depth_m *= scale;
+    l.covariance_m2_per_px2 *= scale * scale;
+  }
+  for (TexturedPlane& p : out.planes) {
+    p.plane.offset *= scale;
+    p.frame.origin *= scale;
+    p.pixels_per_meter /= scale;
+    for (Eigen::Vector2d& v : p.polygon) v *= scale;
+    for (PlaneFeature& f : p.features) f.x_in_world *= scale;
+  }
+  for (TimedPose& t : out.trajectory) {
+    t.world_from_cam.translation *= scale;
+  }
+  return out;
+}
+
 namespace {
 
 // A landmark's nearest true plane among those containing its projection.

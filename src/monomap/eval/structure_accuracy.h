@@ -13,6 +13,13 @@
 
 namespace monomap {
 
+// The map scaled by `scale` about the world origin: positions, depths,
+// plane offsets and extents, texture resolution and the trajectory, so that
+// a similarity alignment (eval/trajectory_metrics.h, Sim3d) can be applied
+// as the scale, then the rigid part. A map takes its scale from the
+// odometry, so a wheel-radius error scales the whole map.
+Map ScaledMap(const Map& map, double scale);
+
 struct StructureAccuracyOptions {
   // A fitted plane matches its true plane if the normals differ by at most
   // this angle (degrees) and the offsets by at most max_match_offset_m.

@@ -32,10 +32,8 @@ TexturedPlane Rectangle(int id, const Eigen::Vector3d& origin,
 Map Truth() {
   Map truth;
   truth.planes.push_back(Rectangle(0, {0, 0, 0}, {1, 0, 0}, {0, 1, 0}, 4, 4));
-  truth.planes.push_back(
-      Rectangle(1, {4, 0, 0}, {0, 1, 0}, {0, 0, 1}, 4, 2.5));
-  truth.planes.push_back(
-      Rectangle(2, {0, 4, 0}, {1, 0, 0}, {0, 0, 1}, 4, 2.5));
+  truth.planes.push_back(Rectangle(1, {4, 0, 0}, {0, 1, 0}, {0, 0, 1}, 4, 2.5));
+  truth.planes.push_back(Rectangle(2, {0, 4, 0}, {1, 0, 0}, {0, 0, 1}, 4, 2.5));
   return truth;
 }
 
@@ -321,6 +319,38 @@ TEST(StructureAccuracyTest, TruthFromMapIsApplied) {
   EXPECT_GT(b.point_error_all.absolute_m.median, 0.1);
 }
 
+TEST(StructureAccuracyTest, ScaledMapUndoesAnOdometryScaleError) {
+  const Map truth = Truth();
+  // The map a 3 % wheel-radius error builds: everything 1.03x as far from
+  // the world origin (where the odometry starts).
+  Map map = ScaledMap(ExactMap(truth), 1.03);
+  for (TexturedPlane& p : map.planes) {
+    p.frame = MakePlaneFrame(p.plane, {1, 1, 1}, {0, 0, 1});
+    p.polygon = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+    p.pixels_per_meter = 100;
+  }
+  map.trajectory.push_back({0.0, Rigid3d::Identity()});
+  map.trajectory.back().world_from_cam.translation = {1, 2, 3};
+  const StructureAccuracy off =
+      EvaluateStructure(map, truth, Rigid3d::Identity(), {});
+  EXPECT_GT(off.point_error_all.absolute_m.median, 0.03);
+  const Map back = ScaledMap(map, 1.0 / 1.03);
+  const StructureAccuracy a =
+      EvaluateStructure(back, truth, Rigid3d::Identity(), {});
+  EXPECT_NEAR(a.point_error_all.absolute_m.max, 0.0, 1e-9);
+  EXPECT_NEAR(a.offset_error_m.max, 0.0, 1e-9);
+  EXPECT_DOUBLE_EQ(a.precision, 1.0);
+  // A texture pixel shows the scaled point; depths and poses scale too.
+  const Eigen::Vector2d px(37, 12);
+  EXPECT_NEAR((back.planes[1].WorldFromTexture(px) -
+               map.planes[1].WorldFromTexture(px) / 1.03)
+                  .norm(),
+              0.0, 1e-12);
+  EXPECT_NEAR(back.landmarks[0].mean_depth_m, 2.0, 1e-12);
+  EXPECT_NEAR(back.trajectory[0].world_from_cam.translation.z(), 3 / 1.03,
+              1e-12);
+}
+
 TEST(StructureAccuracyTest, PolygonMargin) {
   Map truth;
   truth.planes.push_back(Rectangle(0, {0, 0, 0}, {1, 0, 0}, {0, 1, 0}, 4, 4));
@@ -419,12 +449,11 @@ TEST(StructureAccuracyTest, JsonAndTable) {
   EXPECT_EQ(j["counts"]["fitted_planes"].get<int>(), 2);
   EXPECT_EQ(j["counts"]["landmarks"].get<int>(), 209);
   EXPECT_EQ(j["counts"]["landmarks_off_structure"].get<int>(), 0);
-  EXPECT_EQ(j["point_error"]["all_landmarks"]["absolute_m"]["count"]
+  EXPECT_EQ(
+      j["point_error"]["all_landmarks"]["absolute_m"]["count"].get<size_t>(),
+      209u);
+  EXPECT_EQ(j["point_error"]["landmarks_on_planes"]["relative_percent"]["count"]
                 .get<size_t>(),
-            209u);
-  EXPECT_EQ(j["point_error"]["landmarks_on_planes"]["relative_percent"]
-                ["count"]
-                    .get<size_t>(),
             200u);
   ASSERT_EQ(j["planes"]["matches"].size(), 2u);
   const nlohmann::json& m = j["planes"]["matches"][0];
@@ -434,8 +463,7 @@ TEST(StructureAccuracyTest, JsonAndTable) {
   EXPECT_NEAR(m["normal_error_deg"].get<double>(), 1.5, 1e-9);
   EXPECT_NEAR(m["offset_error_m"].get<double>(), 0.0, 1e-12);
   EXPECT_TRUE(m["matched"].get<bool>());
-  EXPECT_NEAR(j["planes"]["normal_error_deg"]["max"].get<double>(), 1.5,
-              1e-9);
+  EXPECT_NEAR(j["planes"]["normal_error_deg"]["max"].get<double>(), 1.5, 1e-9);
   EXPECT_TRUE(j["planes"].contains("offset_error_m"));
   EXPECT_DOUBLE_EQ(j["planes"]["precision"].get<double>(), 1.0);
   EXPECT_DOUBLE_EQ(j["planes"]["recall"].get<double>(), 1.0);
@@ -445,8 +473,7 @@ TEST(StructureAccuracyTest, JsonAndTable) {
   EXPECT_TRUE(j["true_planes"][0]["observed"].get<bool>());
   EXPECT_TRUE(j["true_planes"][0]["matched"].get<bool>());
   EXPECT_EQ(j["true_planes"][0]["near_landmarks"].get<int>(), 100);
-  EXPECT_NEAR(j["true_planes"][0]["normal_error_deg"].get<double>(), 1.5,
-              1e-9);
+  EXPECT_NEAR(j["true_planes"][0]["normal_error_deg"].get<double>(), 1.5, 1e-9);
   EXPECT_FALSE(j["true_planes"][2]["observed"].get<bool>());
   EXPECT_EQ(j["true_planes"][2]["best_fitted_id"].get<int>(), -1);
   EXPECT_TRUE(j["true_planes"][2]["normal_error_deg"].is_null());

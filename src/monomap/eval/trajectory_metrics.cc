@@ -30,8 +30,10 @@ Alignment ParseAlignment(const std::string& name) {
   if (name == "first") return Alignment::kFirstPose;
   if (name == "se3") return Alignment::kSE3;
   if (name == "sim3") return Alignment::kSim3;
-  throw OptionsError("alignment: expected none, first, se3 or sim3, got '" +
-                     name + "'");
+  if (name == "sim3-poses") return Alignment::kSim3Poses;
+  throw OptionsError(
+      "alignment: expected none, first, se3, sim3 or sim3-poses, got '" + name +
+      "'");
 }
 
 std::vector<std::pair<size_t, size_t>> AssociateByTimestamp(
@@ -67,17 +69,61 @@ std::vector<std::pair<size_t, size_t>> AssociateByTimestamp(
 
 namespace {
 
+// kSim3Poses: rotation = the chordal mean of R_gt R_est^T (projected onto
+// SO(3)); with it fixed, scale and translation minimise
+// sum |s R p_est + t - p_gt|^2 in closed form.
+Sim3d AlignPoses(const std::vector<TimedPose>& est,
+                 const std::vector<TimedPose>& gt,
+                 const std::vector<std::pair<size_t, size_t>>& pairs) {
+  Eigen::Matrix3d sum = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d mean_est = Eigen::Vector3d::Zero();
+  Eigen::Vector3d mean_gt = Eigen::Vector3d::Zero();
+  for (const auto& [i, j] : pairs) {
+    sum += (gt[j].world_from_cam.rotation *
+            est[i].world_from_cam.rotation.inverse())
+               .toRotationMatrix();
+    mean_est += est[i].world_from_cam.translation;
+    mean_gt += gt[j].world_from_cam.translation;
+  }
+  mean_est /= static_cast<double>(pairs.size());
+  mean_gt /= static_cast<double>(pairs.size());
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(
+      sum, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d d = Eigen::Matrix3d::Identity();
+  d(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant();
+  const Eigen::Matrix3d r = svd.matrixU() * d * svd.matrixV().transpose();
+  double num = 0.0, den = 0.0;
+  for (const auto& [i, j] : pairs) {
+    const Eigen::Vector3d p =
+        r * (est[i].world_from_cam.translation - mean_est);
+    num += p.dot(gt[j].world_from_cam.translation - mean_gt);
+    den += p.squaredNorm();
+  }
+  if (!(den > 0.0) || !(num > 0.0)) {
+    throw StageError(
+        "trajectory evaluation: estimated positions do not move, the scale "
+        "of a sim3-poses alignment is undetermined");
+  }
+  Sim3d sim;
+  sim.scale = num / den;
+  sim.rigid =
+      Rigid3d(Eigen::Quaterniond(r), mean_gt - sim.scale * r * mean_est);
+  return sim;
+}
+
 Sim3d AlignMatched(const std::vector<TimedPose>& est,
                    const std::vector<TimedPose>& gt,
                    const std::vector<std::pair<size_t, size_t>>& pairs,
                    Alignment alignment) {
   const size_t needed =
-      (alignment == Alignment::kSE3 || alignment == Alignment::kSim3) ? 3 : 2;
+      (alignment == Alignment::kSE3 || alignment == Alignment::kSim3 ||
+       alignment == Alignment::kSim3Poses)
+          ? 3
+          : 2;
   if (pairs.size() < needed) {
-    throw StageError("trajectory evaluation: only " +
-                     std::to_string(pairs.size()) +
-                     " poses matched by timestamp, need " +
-                     std::to_string(needed));
+    throw StageError(
+        "trajectory evaluation: only " + std::to_string(pairs.size()) +
+        " poses matched by timestamp, need " + std::to_string(needed));
   }
   Sim3d sim;
   switch (alignment) {
@@ -87,6 +133,8 @@ Sim3d AlignMatched(const std::vector<TimedPose>& est,
       sim.rigid = gt[pairs[0].second].world_from_cam *
                   est[pairs[0].first].world_from_cam.Inverse();
       return sim;
+    case Alignment::kSim3Poses:
+      return AlignPoses(est, gt, pairs);
     case Alignment::kSE3:
     case Alignment::kSim3:
       break;
@@ -110,8 +158,8 @@ Sim3d AlignMatched(const std::vector<TimedPose>& est,
       Eigen::umeyama(src, dst, alignment == Alignment::kSim3);
   const Eigen::Matrix3d sr = m.topLeftCorner<3, 3>();
   sim.scale = std::cbrt(sr.determinant());
-  sim.rigid = Rigid3d(Eigen::Quaterniond(sr / sim.scale),
-                      m.topRightCorner<3, 1>());
+  sim.rigid =
+      Rigid3d(Eigen::Quaterniond(sr / sim.scale), m.topRightCorner<3, 1>());
   return sim;
 }
 
@@ -137,9 +185,8 @@ TrajectoryErrors AbsoluteTrajectoryError(
   for (const auto& [i, j] : pairs) {
     const Rigid3d& e = estimate[i].world_from_cam;
     const Rigid3d& g = groundtruth[j].world_from_cam;
-    const Eigen::Vector3d p =
-        sim.scale * (sim.rigid.rotation * e.translation) +
-        sim.rigid.translation;
+    const Eigen::Vector3d p = sim.scale * (sim.rigid.rotation * e.translation) +
+                              sim.rigid.translation;
     trans.push_back((p - g.translation).norm());
     rot.push_back(
         RadToDeg(AngleBetween(sim.rigid.rotation * e.rotation, g.rotation)));
@@ -159,11 +206,10 @@ TrajectoryErrors RelativePoseError(const std::vector<TimedPose>& estimate,
   const auto pairs = AssociateByTimestamp(estimate, groundtruth, max_dt);
   const size_t needed = std::max<size_t>(2, delta_frames + 1);
   if (pairs.size() < needed) {
-    throw StageError("relative pose error: only " +
-                     std::to_string(pairs.size()) +
-                     " poses matched by timestamp, need " +
-                     std::to_string(needed) + " for delta " +
-                     std::to_string(delta_frames));
+    throw StageError(
+        "relative pose error: only " + std::to_string(pairs.size()) +
+        " poses matched by timestamp, need " + std::to_string(needed) +
+        " for delta " + std::to_string(delta_frames));
   }
   std::vector<double> trans, rot;
   for (size_t k = 0; k + delta_frames < pairs.size(); ++k) {

@@ -21,9 +21,14 @@ enum class Alignment {
                // first ground-truth pose
   kSE3,        // least-squares rigid transform of the positions (Umeyama)
   kSim3,       // least-squares similarity (rigid + scale) of the positions
+  kSim3Poses,  // similarity whose rotation is the mean of the matched
+               // orientation differences, then scale and translation by
+               // least squares on the positions: determined also for a
+               // straight drive, where kSim3 leaves the roll about the
+               // line free
 };
 
-// "none", "first", "se3" or "sim3" -> Alignment. Throws OptionsError for
+// "none", "first", "se3", "sim3" or "sim3-poses" -> Alignment. Throws OptionsError for
 // another name.
 Alignment ParseAlignment(const std::string& name);
 

@@ -36,8 +36,8 @@ const Rigid3d kWorldChange(Eigen::Quaterniond(Eigen::AngleAxisd(
 // est = scale * kWorldChange applied to gt, plus noise on positions (sigma
 // per axis, metres in the estimate frame) and rotations (sigma radians).
 std::vector<TimedPose> Transformed(const std::vector<TimedPose>& gt,
-                                   double scale, double sigma_t,
-                                   double sigma_r, unsigned seed) {
+                                   double scale, double sigma_t, double sigma_r,
+                                   unsigned seed) {
   std::mt19937 rng(seed);
   std::normal_distribution<double> g(0.0, 1.0);
   std::vector<TimedPose> est = gt;
@@ -114,6 +114,40 @@ TEST(AbsoluteTrajectoryErrorTest, Sim3RecoversScale) {
   EXPECT_LT(sim3.rotation_deg.rms, 0.2);
 }
 
+TEST(AbsoluteTrajectoryErrorTest, Sim3PosesRecoversScaleAlsoOnALine) {
+  const auto gt = GroundTruth();
+  const auto est = Transformed(gt, 0.5, 0.5e-3, DegToRad(0.1), 8);
+  const TrajectoryErrors sim3 =
+      AbsoluteTrajectoryError(est, gt, Alignment::kSim3Poses, 1e-3);
+  EXPECT_NEAR(sim3.scale, 2.0, 2e-3);
+  EXPECT_LT(sim3.translation_m.rms, 3.0e-3);
+  EXPECT_LT(sim3.rotation_deg.rms, 0.2);
+  // A straight drive, 2 % short, in a frame turned by 20 deg about z and
+  // 3 deg about x: the orientations fix the roll about the line that the
+  // positions leave free.
+  const Rigid3d gt_from_est(
+      Eigen::Quaterniond(
+          Eigen::AngleAxisd(DegToRad(20), Eigen::Vector3d::UnitZ()) *
+          Eigen::AngleAxisd(DegToRad(3), Eigen::Vector3d::UnitX())),
+      Eigen::Vector3d(1, -2, 0.3));
+  std::vector<TimedPose> line_gt(20), line_est(20);
+  for (int i = 0; i < 20; ++i) {
+    line_gt[i].timestamp = line_est[i].timestamp = i;
+    line_gt[i].world_from_cam.translation = Eigen::Vector3d(0.1 * i, 0, 0.4);
+    line_est[i].world_from_cam =
+        gt_from_est.Inverse() * line_gt[i].world_from_cam;
+    line_est[i].world_from_cam.translation /= 1.02;
+  }
+  const Sim3d align =
+      AlignTrajectories(line_est, line_gt, Alignment::kSim3Poses);
+  EXPECT_NEAR(align.scale, 1.02, 1e-9);
+  EXPECT_LT(RadToDeg(AngleBetween(align.rigid.rotation, gt_from_est.rotation)),
+            1e-6);
+  EXPECT_THROW(AlignTrajectories(line_est, line_gt, Alignment::kSim3),
+               StageError);
+  EXPECT_EQ(ParseAlignment("sim3-poses"), Alignment::kSim3Poses);
+}
+
 TEST(AbsoluteTrajectoryErrorTest, FirstPoseExactForGlobalTransform) {
   const auto gt = GroundTruth();
   const auto est = Transformed(gt, 1.0, 0.0, 0.0, 9);
@@ -162,8 +196,8 @@ TEST(RelativePoseErrorTest, ConstantPerStepBiasEqualsBias) {
                      Eigen::Vector3d(0.01, 0.0, 0.002));
   std::vector<TimedPose> est = gt;
   for (size_t i = 1; i < gt.size(); ++i) {
-    const Rigid3d step = gt[i - 1].world_from_cam.Inverse() *
-                         gt[i].world_from_cam;
+    const Rigid3d step =
+        gt[i - 1].world_from_cam.Inverse() * gt[i].world_from_cam;
     est[i].world_from_cam = est[i - 1].world_from_cam * step * bias;
   }
   const TrajectoryErrors rpe = RelativePoseError(est, gt, 1, 1e-3);
@@ -181,9 +215,9 @@ TEST(RelativePoseErrorTest, ConstantPerStepBiasEqualsBias) {
   EXPECT_GT(rpe2.translation_m.mean, 1.5 * bias_t);
   EXPECT_NEAR(rpe2.rotation_deg.median, 1.0, 0.05);
   // The ATE of the same drifting trajectory grows far beyond one bias.
-  EXPECT_GT(AbsoluteTrajectoryError(est, gt, Alignment::kFirstPose)
-                .translation_m.max,
-            0.5);
+  EXPECT_GT(
+      AbsoluteTrajectoryError(est, gt, Alignment::kFirstPose).translation_m.max,
+      0.5);
 }
 
 TEST(RelativePoseErrorTest, InvariantToGlobalTransformAndChecksArgs) {

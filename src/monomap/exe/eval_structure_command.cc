@@ -1,5 +1,6 @@
 // monomap eval structure MAP_DIR --structure STRUCTURE_DIR
-//     [--align none|first-pose --groundtruth GT.txt] [--json OUT.json]
+//     [--align none|first-pose|se3|sim3|sim3-poses --groundtruth GT.txt]
+//     [--json OUT.json]
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -23,15 +24,23 @@ struct StructureArgs {
 };
 
 void CheckAlignmentArgs(const StructureArgs& a) {
-  const bool first_pose = a.align == "first-pose";
-  if (first_pose && a.groundtruth.empty()) {
-    throw OptionsError(
-        "eval structure: --align first-pose needs --groundtruth");
+  const bool aligned = a.align != "none";
+  if (aligned && a.groundtruth.empty()) {
+    throw OptionsError("eval structure: --align " + a.align +
+                       " needs --groundtruth");
   }
-  if (!first_pose && !a.groundtruth.empty()) {
+  if (!aligned && !a.groundtruth.empty()) {
     throw OptionsError(
-        "eval structure: --groundtruth is only used with --align first-pose");
+        "eval structure: --groundtruth is only used with --align");
   }
+}
+
+Alignment StructureAlignment(const std::string& name) {
+  if (name == "first-pose") return Alignment::kFirstPose;
+  if (name == "se3") return Alignment::kSE3;
+  if (name == "sim3") return Alignment::kSim3;
+  if (name == "sim3-poses") return Alignment::kSim3Poses;
+  return Alignment::kNone;
 }
 
 // Relative point errors divide by each landmark's mean depth, which
@@ -58,17 +67,21 @@ void RunEvalStructure(const StructureArgs& a) {
   Map map = ReadMap(a.map_dir);
   const Map truth = ReadMap(a.structure_dir);
   const bool have_features = SetDepthsFromFeatures(a.map_dir, &map);
-  Rigid3d truth_from_map;
-  if (a.align == "first-pose") {
+  Sim3d truth_from_map;
+  if (a.align != "none") {
     truth_from_map =
         AlignTrajectories(map.trajectory, ReadTumTrajectory(a.groundtruth),
-                          Alignment::kFirstPose)
-            .rigid;
+                          StructureAlignment(a.align));
+  }
+  // gt ~ scale * R * x + t: scale the map, then move it rigidly.
+  if (truth_from_map.scale != 1.0) {
+    map = ScaledMap(map, truth_from_map.scale);
   }
   const StructureAccuracy acc =
-      EvaluateStructure(map, truth, truth_from_map, a.options);
+      EvaluateStructure(map, truth, truth_from_map.rigid, a.options);
   nlohmann::json j = ToJson(acc);
   j["alignment"] = a.align;
+  j["alignment_scale"] = truth_from_map.scale;
   j["relative_error_depth"] = have_features
                                   ? "mean_distance_to_observing_cameras"
                                   : "distance_to_nearest_camera";
@@ -95,11 +108,18 @@ void RegisterEvalStructureCommand(CLI::App* eval) {
   cmd->add_option("--align", a->align,
                   "none: the map is in the truth's frame (the simulator's "
                   "odometry starts at the true pose); first-pose: align "
-                  "the map's first trajectory pose to --groundtruth")
-      ->check(CLI::IsMember({"none", "first-pose"}))
+                  "the map's first trajectory pose to --groundtruth; "
+                  "se3 / sim3: the rigid / similarity transform that best "
+                  "fits the map's trajectory positions to --groundtruth "
+                  "(sim3 removes the scale error the odometry gives the "
+                  "map); sim3-poses: the similarity with its rotation from "
+                  "the trajectory's orientations (determined also for a "
+                  "straight drive)")
+      ->check(
+          CLI::IsMember({"none", "first-pose", "se3", "sim3", "sim3-poses"}))
       ->capture_default_str();
   cmd->add_option("--groundtruth", a->groundtruth,
-                  "Ground-truth trajectory (TUM) for --align first-pose");
+                  "Ground-truth trajectory (TUM) for --align");
   cmd->add_option("--json", a->json, "Write the figures as JSON");
   cmd->callback([a]() { RunEvalStructure(*a); });
 }

@@ -1,5 +1,5 @@
 // monomap eval trajectory ESTIMATE.txt GROUNDTRUTH.txt
-//     [--align none|first|se3|sim3] [--delta N] [--json OUT.json]
+//     [--align none|first|se3|sim3|sim3-poses] [--delta N] [--json OUT.json]
 #include <memory>
 
 #include "monomap/eval/report_json.h"
@@ -22,8 +22,10 @@ void RegisterEvalTrajectoryCommand(CLI::App* eval) {
   cmd->add_option("groundtruth", a->groundtruth,
                   "Ground-truth trajectory (TUM)")
       ->required();
-  cmd->add_option("--align", a->align, "none | first | se3 | sim3")
-      ->check(CLI::IsMember({"none", "first", "se3", "sim3"}))
+  cmd->add_option("--align", a->align,
+                  "none | first | se3 | sim3 | sim3-poses (the similarity "
+                  "with its rotation from the orientations)")
+      ->check(CLI::IsMember({"none", "first", "se3", "sim3", "sim3-poses"}))
       ->capture_default_str();
   cmd->add_option("--delta", a->delta, "Frame delta of the relative error")
       ->capture_default_str();

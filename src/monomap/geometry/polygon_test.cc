@@ -6,7 +6,7 @@ namespace monomap {
 namespace {
 
 TEST(Polygon, HullAreaAndInside) {
-  std::vector<Eigen::Vector2d> pts = {{0, 0}, {2, 0}, {2, 1}, {0, 1},
+  std::vector<Eigen::Vector2d> pts = {{0, 0},   {2, 0},     {2, 1}, {0, 1},
                                       {1, 0.5}, {0.5, 0.2}, {2, 0}};
   const Polygon2d hull = ConvexHull(pts);
   EXPECT_EQ(hull.size(), 4u);
