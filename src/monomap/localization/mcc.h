@@ -28,7 +28,7 @@ struct MccOptions {
   // KLT window side and pyramid levels above the base. Few levels and a
   // small window: at 160x120 the top of a 3-level pyramid is 20x15 px, its
   // windows span the map's silhouette against the background, and most
-  // tracks run off (docs/benchmarks.md, MCC basin; bench/mcc_basin).
+  // tracks run off (docs/design-notes.md, "Localization"; bench/mcc_basin).
   int klt_window = 11;
   int klt_levels = 1;
   // Forward-backward KLT check: largest round-trip error (px).

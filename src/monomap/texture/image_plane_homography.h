@@ -26,11 +26,9 @@ struct HomographyOptions {
   // Features that check (and refine) a homography: those whose landmark
   // projects within this many pixels of its projection onto the plane, so
   // that parallax of points off the plane (within the plane fit's band) is
-  // not taken for a homography error. Desk, 150 frames: 138 of 150
-  // homographies were refined on such parallax (median residual 1.26 px,
-  // 0.52 px without it), which registered the texture to the features
-  // instead of the poses; localizing the mapping frames against their own
-  // map then missed the map's poses by 0.57 deg instead of 0.13.
+  // not taken for a homography error: refining on that parallax registers
+  // the texture to the features instead of the poses (design-notes.md,
+  // "Homographies and texture").
   double max_feature_parallax_px = 0.5;
   // Refine when the median feature residual exceeds this (pixels).
   double refine_threshold_px = 1.0;
