@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <random>
 
-#include "monomap/sim/synthetic_scene.h"
+#include "monomap/sim/test_scene.h"
 #include "monomap/triangulation/triangulator.h"
 #include "monomap/util/angles.h"
 #include "monomap/util/error.h"
@@ -27,7 +27,7 @@ struct Errors {
 // odometry shares with the truth; the scale is kept by the odometry (0.5%
 // off), so the "scaled" figure removes the best scale about the first camera
 // centre to show the shape error alone.
-Errors Compare(const SyntheticScene& scene,
+Errors Compare(const testing::TestScene& scene,
                const std::vector<Rigid3d>& world_from_cam,
                const std::vector<Landmark>& landmarks) {
   Errors e;
@@ -61,18 +61,18 @@ Errors Compare(const SyntheticScene& scene,
 }
 
 // A synthetic scene whose tracks carry 0.3 px of pixel noise.
-SyntheticScene NoisyScene(int num_tracks, uint64_t seed) {
-  SyntheticSceneOptions options;
-  options.num_tracks = num_tracks;
-  options.pixel_noise_px = 0.3;
+testing::TestScene NoisyScene(int num_tracks, uint64_t seed) {
+  testing::TestSceneOptions options;
+  options.points.num_tracks = num_tracks;
+  options.points.pixel_noise_px = 0.3;
   options.seed = seed;
-  return MakeSyntheticScene(options);
+  return testing::MakeTestScene(options);
 }
 
 TEST(BundleAdjustmentTest, CorrectsOdometryDrift) {
-  const SyntheticScene scene = NoisyScene(400, 11);
-  std::vector<Rigid3d> poses =
-      SimulateOdometryDrift(scene.world_from_cam, OdometryDriftOptions());
+  const testing::TestScene scene = NoisyScene(400, 11);
+  std::vector<Rigid3d> poses = testing::SimulateOdometryDrift(
+      scene.world_from_cam, testing::OdometryDriftOptions());
 
   std::vector<Landmark> landmarks;
   const TriangulationReport tri = TriangulateTracks(
@@ -80,9 +80,9 @@ TEST(BundleAdjustmentTest, CorrectsOdometryDrift) {
   ASSERT_GT(tri.num_points, 300);
   const Errors before = Compare(scene, poses, landmarks);
 
-  const BundleAdjustmentReport report = BundleAdjust(
-      scene.camera, scene.tracks, BundleAdjustmentOptions(), &poses,
-      &landmarks);
+  const BundleAdjustmentReport report =
+      BundleAdjust(scene.camera, scene.tracks, BundleAdjustmentOptions(),
+                   &poses, &landmarks);
   const Errors after = Compare(scene, poses, landmarks);
   std::printf(
       "tri %d pts, err %.3f px; BA rms %.3f -> %.3f px, median %.3f -> %.3f, "
@@ -124,7 +124,7 @@ TEST(BundleAdjustmentTest, CorrectsOdometryDrift) {
 
 // Median over frames of the rotation of cam_i_from_cam_{i+1} against the
 // truth's (degrees): how well the motion from frame to frame is known.
-double MedianStepRotationErrorDeg(const SyntheticScene& scene,
+double MedianStepRotationErrorDeg(const testing::TestScene& scene,
                                   const std::vector<Rigid3d>& world_from_cam) {
   std::vector<double> errors;
   for (size_t i = 0; i + 1 < world_from_cam.size(); ++i) {
@@ -143,9 +143,9 @@ double MedianStepRotationErrorDeg(const SyntheticScene& scene,
 // the poses to that jitter. Loose per-step priors plus span priors let the
 // images set the motion from frame to frame while the spans hold the drift.
 TEST(BundleAdjustmentTest, SpanPriorsLetTheImagesRemoveOdometryJitter) {
-  const SyntheticScene scene = NoisyScene(400, 11);
-  std::vector<Rigid3d> odometry =
-      SimulateOdometryDrift(scene.world_from_cam, OdometryDriftOptions());
+  const testing::TestScene scene = NoisyScene(400, 11);
+  std::vector<Rigid3d> odometry = testing::SimulateOdometryDrift(
+      scene.world_from_cam, testing::OdometryDriftOptions());
   std::mt19937_64 rng(5);
   std::normal_distribution<double> jitter(0.0, DegToRad(0.05));
   for (size_t i = 1; i < odometry.size(); ++i) {
@@ -198,7 +198,7 @@ TEST(BundleAdjustmentTest, SpanPriorsLetTheImagesRemoveOdometryJitter) {
 
 // Triangulates `tracks` with `camera` against the odometry, adjusts, and
 // compares with the scene's truth.
-Errors AdjustWithLens(const SyntheticScene& scene, const Camera& camera,
+Errors AdjustWithLens(const testing::TestScene& scene, const Camera& camera,
                       const std::vector<Track>& tracks,
                       const std::vector<Rigid3d>& odometry,
                       const BundleAdjustmentOptions& options,
@@ -216,11 +216,11 @@ Errors AdjustWithLens(const SyntheticScene& scene, const Camera& camera,
 // bends the adjusted poses; refining the distortion in the adjustment finds
 // the lens again and straightens them.
 TEST(BundleAdjustmentTest, RefinesAWrongDistortion) {
-  const SyntheticScene scene = NoisyScene(500, 13);
+  const testing::TestScene scene = NoisyScene(500, 13);
   Camera wrong = scene.camera;
   wrong.distortion[0] += 0.02;
-  const std::vector<Rigid3d> odometry =
-      SimulateOdometryDrift(scene.world_from_cam, OdometryDriftOptions());
+  const std::vector<Rigid3d> odometry = testing::SimulateOdometryDrift(
+      scene.world_from_cam, testing::OdometryDriftOptions());
   auto run = [&](bool refine, BundleAdjustmentReport* report) {
     BundleAdjustmentOptions options;
     options.refine_distortion = refine;
@@ -250,27 +250,27 @@ TEST(BundleAdjustmentTest, RefinesAWrongDistortion) {
 }
 
 // A scene seen through a fisheye (equidistant) lens, 0.3 px noise.
-SyntheticScene FisheyeScene() {
-  SyntheticSceneOptions options;
-  options.num_tracks = 500;
-  options.pixel_noise_px = 0.3;
+testing::TestScene FisheyeScene() {
+  testing::TestSceneOptions options;
+  options.points.num_tracks = 500;
+  options.points.pixel_noise_px = 0.3;
   options.seed = 13;
-  Camera fisheye = SyntheticCamera();
+  Camera fisheye = testing::SyntheticCamera();
   fisheye.fx = fisheye.fy = 300.0;
   fisheye.model = LensModel::kEquidistant;
   fisheye.distortion = {0.02, -0.004, 0.001, -0.0002, 0.0};
   options.camera = fisheye;
-  return MakeSyntheticScene(options);
+  return testing::MakeTestScene(options);
 }
 
 // The same with a fisheye (equidistant) lens: triangulation and adjustment
 // project through the camera's own model, and refining k1..k4 finds a
 // wrong k1 again while k5 stays 0.
 TEST(BundleAdjustmentTest, FisheyeLensAdjustsAndRefines) {
-  const SyntheticScene scene = FisheyeScene();
+  const testing::TestScene scene = FisheyeScene();
   const Camera& fisheye = scene.camera;
-  const std::vector<Rigid3d> odometry =
-      SimulateOdometryDrift(scene.world_from_cam, OdometryDriftOptions());
+  const std::vector<Rigid3d> odometry = testing::SimulateOdometryDrift(
+      scene.world_from_cam, testing::OdometryDriftOptions());
   BundleAdjustmentOptions ba;
   BundleAdjustmentReport right_report, refined_report;
   const Errors right =
@@ -324,11 +324,11 @@ TEST(BundleAdjustmentTest, FisheyeLensAdjustsAndRefines) {
 // corners. Bundle adjustment on every observation bends the poses to fit
 // the rim; leaving out the observations beyond 250 px keeps them straight.
 TEST(BundleAdjustmentTest, ObservationsBeyondTheCalibratedRadiusLeftOut) {
-  const SyntheticScene scene = NoisyScene(500, 17);
+  const testing::TestScene scene = NoisyScene(500, 17);
   Camera wrong = scene.camera;
   wrong.distortion[4] += 0.02;
-  const std::vector<Rigid3d> odometry =
-      SimulateOdometryDrift(scene.world_from_cam, OdometryDriftOptions());
+  const std::vector<Rigid3d> odometry = testing::SimulateOdometryDrift(
+      scene.world_from_cam, testing::OdometryDriftOptions());
   auto run = [&](const std::vector<Track>& tracks) {
     return AdjustWithLens(scene, wrong, tracks, odometry,
                           BundleAdjustmentOptions());
@@ -364,9 +364,9 @@ TEST(BundleAdjustmentTest, ObservationsBeyondTheCalibratedRadiusLeftOut) {
 // many frames) must not change the solution: preconditioned CG solves each
 // step only approximately, but LM converges to the same minimum.
 TEST(BundleAdjustmentTest, IterativeSchurReachesTheDirectSolution) {
-  const SyntheticScene scene = NoisyScene(300, 5);
-  const std::vector<Rigid3d> odometry =
-      SimulateOdometryDrift(scene.world_from_cam, OdometryDriftOptions());
+  const testing::TestScene scene = NoisyScene(300, 5);
+  const std::vector<Rigid3d> odometry = testing::SimulateOdometryDrift(
+      scene.world_from_cam, testing::OdometryDriftOptions());
   std::vector<Landmark> triangulated;
   TriangulateTracks(scene.camera, odometry, scene.tracks,
                     TriangulationOptions(), &triangulated);
@@ -381,8 +381,7 @@ TEST(BundleAdjustmentTest, IterativeSchurReachesTheDirectSolution) {
   };
   std::vector<Rigid3d> direct_poses, cg_poses;
   std::vector<Landmark> direct_points, cg_points;
-  const BundleAdjustmentReport direct =
-      run(0.0, &direct_poses, &direct_points);
+  const BundleAdjustmentReport direct = run(0.0, &direct_poses, &direct_points);
   // Below the scene's covisibility: the automatic choice takes CG.
   const BundleAdjustmentReport cg =
       run(0.5 * direct.covisibility, &cg_poses, &cg_points);
@@ -412,9 +411,10 @@ TEST(BundleAdjustmentTest, IterativeSchurReachesTheDirectSolution) {
 }
 
 TEST(BundleAdjustmentTest, DisabledLeavesInputUnchanged) {
-  const SyntheticScene scene = NoisyScene(100, SyntheticSceneOptions().seed);
-  std::vector<Rigid3d> poses =
-      SimulateOdometryDrift(scene.world_from_cam, OdometryDriftOptions());
+  const testing::TestScene scene =
+      NoisyScene(100, testing::TestSceneOptions().seed);
+  std::vector<Rigid3d> poses = testing::SimulateOdometryDrift(
+      scene.world_from_cam, testing::OdometryDriftOptions());
   std::vector<Landmark> landmarks;
   TriangulateTracks(scene.camera, poses, scene.tracks, TriangulationOptions(),
                     &landmarks);
@@ -437,9 +437,9 @@ TEST(BundleAdjustmentTest, DisabledLeavesInputUnchanged) {
 }
 
 TEST(BundleAdjustmentTest, RejectsBadInput) {
-  SyntheticSceneOptions scene_options;
-  scene_options.num_tracks = 20;
-  const SyntheticScene scene = MakeSyntheticScene(scene_options);
+  testing::TestSceneOptions scene_options;
+  scene_options.points.num_tracks = 20;
+  const testing::TestScene scene = testing::MakeTestScene(scene_options);
   std::vector<Rigid3d> poses = scene.world_from_cam;
   std::vector<Landmark> landmarks(1);
   landmarks[0].id = 12345;  // no such track
@@ -465,11 +465,11 @@ TEST(BundleAdjustmentTest, RejectsBadInput) {
 // posterior std proves it constrained, and points and poses come out about
 // as accurate as with the true lens.
 TEST(BundleAdjustmentTest, SelfCalibrationRecoversAPerturbedRadialLens) {
-  const SyntheticScene scene = NoisyScene(500, 13);
+  const testing::TestScene scene = NoisyScene(500, 13);
   Camera wrong = scene.camera;
   wrong.distortion[0] *= 0.85;
-  const std::vector<Rigid3d> odometry =
-      SimulateOdometryDrift(scene.world_from_cam, OdometryDriftOptions());
+  const std::vector<Rigid3d> odometry = testing::SimulateOdometryDrift(
+      scene.world_from_cam, testing::OdometryDriftOptions());
   BundleAdjustmentOptions refine;
   refine.intrinsics.enabled = true;
   BundleAdjustmentReport true_report, wrong_report, refined_report;
@@ -527,7 +527,7 @@ void ExpectKeptUnconstrained(const IntrinsicsRefinementReport& lens,
 // focal length, the trial finds its posterior std near the prior's and keeps
 // the given value, and the report says why.
 TEST(BundleAdjustmentTest, SelfCalibrationKeepsAnUnconstrainedFocalLength) {
-  const SyntheticScene scene = NoisyScene(60, 5);
+  const testing::TestScene scene = NoisyScene(60, 5);
   Camera given = scene.camera;
   given.fx *= 1.01;
   given.fy *= 1.01;
@@ -551,11 +551,11 @@ TEST(BundleAdjustmentTest, SelfCalibrationKeepsAnUnconstrainedFocalLength) {
 // the radial distortion, so the default trial keeps the given (wrong) k1,
 // and the report says why.
 TEST(BundleAdjustmentTest, SelfCalibrationKeepsTheLensWhenOnlyTheCentreIsSeen) {
-  SyntheticSceneOptions options;
-  options.num_tracks = 3000;
-  options.pixel_noise_px = 0.3;
+  testing::TestSceneOptions options;
+  options.points.num_tracks = 3000;
+  options.points.pixel_noise_px = 0.3;
   options.seed = 7;
-  const SyntheticScene scene = MakeSyntheticScene(options);
+  const testing::TestScene scene = testing::MakeTestScene(options);
   const Eigen::Vector2d centre(scene.camera.cx, scene.camera.cy);
   std::vector<Track> central;
   for (const Track& t : scene.tracks) {
@@ -586,10 +586,10 @@ TEST(BundleAdjustmentTest, SelfCalibrationKeepsTheLensWhenOnlyTheCentreIsSeen) {
 // Self-calibration of a fisheye (equidistant) lens: the lens block's k1, k2
 // are the equidistant k1, k2 (k3, k4 kept); a wrong k1 is found again.
 TEST(BundleAdjustmentTest, SelfCalibrationRecoversAFisheyeK1) {
-  const SyntheticScene scene = FisheyeScene();
+  const testing::TestScene scene = FisheyeScene();
   const Camera& fisheye = scene.camera;
-  const std::vector<Rigid3d> odometry =
-      SimulateOdometryDrift(scene.world_from_cam, OdometryDriftOptions());
+  const std::vector<Rigid3d> odometry = testing::SimulateOdometryDrift(
+      scene.world_from_cam, testing::OdometryDriftOptions());
   Camera wrong = fisheye;
   wrong.distortion[0] += 0.03;
   BundleAdjustmentOptions refine;

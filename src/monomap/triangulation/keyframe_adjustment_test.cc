@@ -4,7 +4,7 @@
 
 #include <cstdio>
 
-#include "monomap/sim/synthetic_scene.h"
+#include "monomap/sim/test_scene.h"
 #include "monomap/triangulation/triangulator.h"
 #include "monomap/util/angles.h"
 #include "monomap/util/error.h"
@@ -63,23 +63,23 @@ TEST(KeyframeAdjustmentTest, LongSequencesAreSpacedByTravel) {
 // poses nearly as good as every third frame, from a problem a sixth the
 // size.
 TEST(KeyframeAdjustmentTest, TravelSpacedKeyframesKeepThePoses) {
-  SyntheticSceneOptions scene_options;
+  testing::TestSceneOptions scene_options;
   scene_options.num_frames = 600;
-  scene_options.step_m = 0.002;
-  scene_options.num_tracks = 800;
-  scene_options.min_track_length = 80;
-  scene_options.max_track_length = 200;
+  scene_options.points.step_m = 0.002;
+  scene_options.points.num_tracks = 800;
+  scene_options.points.min_track_length = 80;
+  scene_options.points.max_track_length = 200;
   // At hallway depths: 4 cm is 2-4 % of the distance.
-  scene_options.min_depth_m = 1.0;
-  scene_options.max_depth_m = 2.0;
-  scene_options.pixel_noise_px = 0.3;
+  scene_options.points.min_depth_m = 1.0;
+  scene_options.points.max_depth_m = 2.0;
+  scene_options.points.pixel_noise_px = 0.3;
   scene_options.seed = 21;
-  const SyntheticScene scene = MakeSyntheticScene(scene_options);
+  const testing::TestScene scene = testing::MakeTestScene(scene_options);
   // The simulator's wheel odometry: 1.5 % random error a step.
-  OdometryDriftOptions drift;
+  testing::OdometryDriftOptions drift;
   drift.translation_noise_fraction = 0.015;
   const std::vector<Rigid3d> odometry =
-      SimulateOdometryDrift(scene.world_from_cam, drift);
+      testing::SimulateOdometryDrift(scene.world_from_cam, drift);
   std::vector<Landmark> triangulated;
   TriangulateTracks(scene.camera, odometry, scene.tracks,
                     TriangulationOptions(), &triangulated);

@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <random>
 
-#include "monomap/sim/synthetic_scene.h"
+#include "monomap/sim/test_scene.h"
 #include "monomap/triangulation/triangulator.h"
 #include "monomap/util/error.h"
 
@@ -21,11 +21,11 @@ constexpr int kTiny = 7;   // 8 frames, 21 mm baseline at 2.5 m: ~0.5 deg
 // simulated scene plus planted bad tracks: the quality the filter judges is
 // the one triangulation measured. Ids >= kClean are the planted ones.
 std::vector<Landmark> LandmarksWithPlantedBadPoints() {
-  SyntheticSceneOptions scene_options;
-  scene_options.num_tracks = kClean;
-  scene_options.pixel_noise_px = 0.3;
+  testing::TestSceneOptions scene_options;
+  scene_options.points.num_tracks = kClean;
+  scene_options.points.pixel_noise_px = 0.3;
   scene_options.seed = 11;
-  const SyntheticScene scene = MakeSyntheticScene(scene_options);
+  const testing::TestScene scene = testing::MakeTestScene(scene_options);
   std::vector<Track> tracks = scene.tracks;
   FeatureId next_id = kClean;
   for (int k = 0; k < kShort; ++k) {

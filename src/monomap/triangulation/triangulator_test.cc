@@ -7,7 +7,7 @@
 #include <algorithm>
 #include <random>
 
-#include "monomap/sim/synthetic_scene.h"
+#include "monomap/sim/test_scene.h"
 #include "monomap/util/error.h"
 #include "monomap/util/stats.h"
 
@@ -15,13 +15,13 @@ namespace monomap {
 namespace {
 
 TEST(TriangulatorTest, ExactObservationsGiveExactPoints) {
-  SyntheticSceneOptions scene_options;
-  scene_options.num_tracks = 300;
-  const SyntheticScene scene = MakeSyntheticScene(scene_options);
+  testing::TestSceneOptions scene_options;
+  scene_options.points.num_tracks = 300;
+  const testing::TestScene scene = testing::MakeTestScene(scene_options);
   std::vector<Landmark> landmarks;
-  const TriangulationReport report = TriangulateTracks(
-      scene.camera, scene.world_from_cam, scene.tracks, TriangulationOptions(),
-      &landmarks);
+  const TriangulationReport report =
+      TriangulateTracks(scene.camera, scene.world_from_cam, scene.tracks,
+                        TriangulationOptions(), &landmarks);
   EXPECT_EQ(report.num_tracks, 300);
   ASSERT_EQ(report.num_points, 300);
   ASSERT_EQ(landmarks.size(), 300u);
@@ -43,11 +43,11 @@ TEST(TriangulatorTest, ExactObservationsGiveExactPoints) {
 }
 
 TEST(TriangulatorTest, NoisyTracksWithOutliersAndDegenerateCases) {
-  SyntheticSceneOptions scene_options;
-  scene_options.num_tracks = 400;
-  scene_options.pixel_noise_px = 0.3;
+  testing::TestSceneOptions scene_options;
+  scene_options.points.num_tracks = 400;
+  scene_options.points.pixel_noise_px = 0.3;
   scene_options.seed = 7;
-  SyntheticScene scene = MakeSyntheticScene(scene_options);
+  testing::TestScene scene = testing::MakeTestScene(scene_options);
   const Camera& camera = scene.camera;
   const int num_clean = 400;
   std::vector<Track> tracks = scene.tracks;
@@ -140,17 +140,18 @@ TEST(TriangulatorTest, CovarianceMatchesTheActualErrors) {
   // With Gaussian pixel noise sigma, the error e of a refined point is
   // approximately N(0, sigma^2 C): e^T (sigma^2 C)^-1 e is chi-square with
   // 3 degrees of freedom (mean 3, median 2.37; measured 3.03 and 2.33).
-  SyntheticSceneOptions scene_options;
-  scene_options.num_tracks = 600;
-  scene_options.pixel_noise_px = 0.3;
+  testing::TestSceneOptions scene_options;
+  scene_options.points.num_tracks = 600;
+  scene_options.points.pixel_noise_px = 0.3;
   scene_options.seed = 11;
-  const SyntheticScene scene = MakeSyntheticScene(scene_options);
+  const testing::TestScene scene = testing::MakeTestScene(scene_options);
   std::vector<Landmark> landmarks;
   TriangulateTracks(scene.camera, scene.world_from_cam, scene.tracks,
                     TriangulationOptions(), &landmarks);
   ASSERT_GT(landmarks.size(), 500u);
   std::vector<double> mahalanobis2, anisotropy;
-  const double var = scene_options.pixel_noise_px * scene_options.pixel_noise_px;
+  const double var =
+      scene_options.points.pixel_noise_px * scene_options.points.pixel_noise_px;
   for (const Landmark& l : landmarks) {
     const Eigen::Matrix3d c = var * l.covariance_m2_per_px2;
     ASSERT_GT(c.determinant(), 0.0);
@@ -172,10 +173,10 @@ TEST(TriangulatorTest, CovarianceMatchesTheActualErrors) {
 }
 
 TEST(TriangulatorTest, LinearOnlyIsWorseThanRefined) {
-  SyntheticSceneOptions scene_options;
-  scene_options.num_tracks = 300;
-  scene_options.pixel_noise_px = 0.5;
-  const SyntheticScene scene = MakeSyntheticScene(scene_options);
+  testing::TestSceneOptions scene_options;
+  scene_options.points.num_tracks = 300;
+  scene_options.points.pixel_noise_px = 0.5;
+  const testing::TestScene scene = testing::MakeTestScene(scene_options);
   TriangulationOptions options;
   std::vector<Landmark> refined, linear;
   const TriangulationReport r1 = TriangulateTracks(
@@ -188,7 +189,8 @@ TEST(TriangulatorTest, LinearOnlyIsWorseThanRefined) {
 }
 
 TEST(TriangulatorTest, RejectsBadInput) {
-  const SyntheticScene scene = MakeSyntheticScene(SyntheticSceneOptions());
+  const testing::TestScene scene =
+      testing::MakeTestScene(testing::TestSceneOptions());
   std::vector<Landmark> landmarks;
   std::vector<Rigid3d> too_few(scene.world_from_cam.begin(),
                                scene.world_from_cam.begin() + 10);
