@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include "monomap/io/bag_import_test_suite.h"
 #include "monomap/io/bag_test_sequence.h"
 #include "monomap/io/rosbag2_test_bag.h"
 #include "monomap/util/error.h"
@@ -37,35 +38,23 @@ fs::path WriteBag(const std::string& name, const BagSpec& spec) {
   return dir;
 }
 
-void CheckImport(const BagSpec& spec) {
-  const fs::path bag = WriteBag("bag", spec);
-  const fs::path out = kDir / "dataset";
-  CheckImportedDrive(spec, ImportRosbag2(bag, out, Options(spec)), out);
-}
-
-TEST(Rosbag2Import, Mono8WithOdometryTopic) { CheckImport({}); }
-
-TEST(Rosbag2Import, Rgb8WithTfOdometry) {
-  BagSpec spec;
-  spec.encoding = "rgb8";
-  spec.odom_as_tf = true;
-  CheckImport(spec);
-}
-
-TEST(Rosbag2Import, Bgr8WithEquidistantCameraInfo) {
-  BagSpec spec;
-  spec.encoding = "bgr8";
-  spec.fisheye = true;
-  CheckImport(spec);
-}
-
-TEST(Rosbag2Import, CompressedPngAndJpeg) {
-  BagSpec spec;
-  spec.encoding = "png";
-  CheckImport(spec);
-  spec.encoding = "jpeg";
-  CheckImport(spec);
-}
+// The format for the shared suite (bag_import_test_suite.h).
+struct Ros2 {
+  static constexpr const char* kName = "ros2";
+  static fs::path Write(const fs::path& dir, const std::string& name,
+                        const BagSpec& spec) {
+    const fs::path path = dir / name;
+    Ros2BagWriter bag(path);
+    LogDrive(spec, bag);
+    bag.Close();
+    return path;
+  }
+  static RosbagImportReport Import(const fs::path& bag, const fs::path& out,
+                                   const RosbagImportOptions& o) {
+    return ImportRosbag2(bag, out, o);
+  }
+};
+INSTANTIATE_TYPED_TEST_SUITE_P(Ros2, BagImportTest, Ros2);
 
 TEST(Rosbag2Import, ALoneDb3OrTheMetadataFileWorkToo) {
   const fs::path bag = WriteBag("bag", {});
@@ -170,28 +159,6 @@ TEST(Rosbag2Import, CompressedImageSizeIsCheckedBeforeDecoding) {
              "the limit");
 }
 
-TEST(Rosbag2Import, BadEncodingCalibrationAndLensNameTheField) {
-  BagSpec spec;
-  spec.encoding = "bgra8";
-  EXPECT_HAS(ImportError(WriteBag("enc", spec), Options(spec)),
-             "enc: topic '/cam/image_raw': field 'encoding': "
-             "'bgra8' is not supported");
-  spec = {};
-  spec.calibrated = false;
-  EXPECT_HAS(ImportError(WriteBag("uncal", spec), Options(spec)),
-             "uncal: topic '/cam/camera_info': field 'K': no calibration");
-  spec = {};
-  spec.distortion_model = "rational_polynomial";
-  EXPECT_HAS(ImportError(WriteBag("rational", spec), Options(spec)),
-             "rational: topic '/cam/camera_info': field 'distortion_model': "
-             "'rational_polynomial' is not supported");
-  spec = {};
-  spec.distortion_model = "equidistant";  // with plumb_bob's 5 numbers
-  EXPECT_HAS(ImportError(WriteBag("five", spec), Options(spec)),
-             "five: topic '/cam/camera_info': field 'D': equidistant needs 4 "
-             "coefficients, got 5");
-}
-
 TEST(Rosbag2Import, McapStorageAndNonCdrSerializationAreRefused) {
   const fs::path dir = kDir / "mcap";
   fs::remove_all(dir);
@@ -216,12 +183,6 @@ TEST(Rosbag2Import, McapStorageAndNonCdrSerializationAreRefused) {
   EXPECT_HAS(ImportError(json, o),
              "json/bag_0.db3: topic '/odom_json': field "
              "'serialization_format': 'json' is not supported (cdr)");
-}
-
-TEST(Rosbag2Import, MissingMountIsAnErrorUnlessAFileGivesIt) {
-  BagSpec spec;
-  spec.with_tf_static = false;
-  CheckMissingMount(ImportRosbag2, WriteBag("nomount", spec), kDir);
 }
 
 }  // namespace

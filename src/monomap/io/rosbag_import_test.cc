@@ -5,6 +5,7 @@
 
 #include <fstream>
 
+#include "monomap/io/bag_import_test_suite.h"
 #include "monomap/io/bag_test_sequence.h"
 #include "monomap/io/dataset.h"
 #include "monomap/io/rosbag_test_bag.h"
@@ -38,35 +39,22 @@ fs::path WriteBag(const std::string& name, const BagSpec& spec) {
   return path;
 }
 
-// Imports a bag of `spec` and checks everything the importer promises.
-void CheckImport(const BagSpec& spec) {
-  const fs::path bag = WriteBag("test.bag", spec);
-  const fs::path out = kDir / "dataset";
-  CheckImportedDrive(spec, ImportRosbag(bag, out, Options(spec)), out);
-}
-
-TEST(RosbagImport, Mono8WithOdometryTopic) { CheckImport({}); }
-
-TEST(RosbagImport, Rgb8WithTfOdometry) {
-  BagSpec spec;
-  spec.encoding = "rgb8";
-  spec.odom_as_tf = true;
-  CheckImport(spec);
-}
-
-TEST(RosbagImport, EquidistantCameraInfo) {
-  BagSpec spec;
-  spec.fisheye = true;
-  CheckImport(spec);
-}
-
-TEST(RosbagImport, CompressedPngAndJpeg) {
-  BagSpec spec;
-  spec.encoding = "png";
-  CheckImport(spec);
-  spec.encoding = "jpeg";
-  CheckImport(spec);
-}
+// The format for the shared suite (bag_import_test_suite.h).
+struct Ros1 {
+  static constexpr const char* kName = "ros1";
+  static fs::path Write(const fs::path& dir, const std::string& name,
+                        const BagSpec& spec) {
+    const fs::path path = dir / (name + ".bag");
+    Ros1Sink sink(path);
+    LogDrive(spec, sink);
+    return path;
+  }
+  static RosbagImportReport Import(const fs::path& bag, const fs::path& out,
+                                   const RosbagImportOptions& o) {
+    return ImportRosbag(bag, out, o);
+  }
+};
+INSTANTIATE_TYPED_TEST_SUITE_P(Ros1, BagImportTest, Ros1);
 
 std::string ImportError(const fs::path& bag, const RosbagImportOptions& o) {
   return bag_test::ImportError(ImportRosbag, bag, kDir / "kept", o);
@@ -93,37 +81,6 @@ TEST(RosbagImport, TruncatedBagIsNamed) {
   WriteFileAtomic(cut, bytes.substr(0, bytes.size() / 2));
   const std::string e = ImportError(cut, Options({}));
   EXPECT_NE(e.find("cut.bag: cannot read the bag"), std::string::npos) << e;
-}
-
-TEST(RosbagImport, BadEncodingCalibrationAndLensNameTheField) {
-  BagSpec spec;
-  spec.encoding = "bgra8";
-  std::string e = ImportError(WriteBag("enc.bag", spec), Options(spec));
-  EXPECT_NE(e.find("enc.bag: topic '/cam/image_raw': field 'encoding': "
-                   "'bgra8' is not supported"),
-            std::string::npos)
-      << e;
-  spec = {};
-  spec.calibrated = false;
-  e = ImportError(WriteBag("uncal.bag", spec), Options(spec));
-  EXPECT_NE(e.find("uncal.bag: topic '/cam/camera_info': field 'K': no "
-                   "calibration"),
-            std::string::npos)
-      << e;
-  spec = {};
-  spec.distortion_model = "rational_polynomial";
-  e = ImportError(WriteBag("rational.bag", spec), Options(spec));
-  EXPECT_NE(e.find("rational.bag: topic '/cam/camera_info': field "
-                   "'distortion_model': 'rational_polynomial' is not "
-                   "supported"),
-            std::string::npos)
-      << e;
-}
-
-TEST(RosbagImport, MissingMountIsAnErrorUnlessAFileGivesIt) {
-  BagSpec spec;
-  spec.with_tf_static = false;
-  CheckMissingMount(ImportRosbag, WriteBag("nomount.bag", spec), kDir);
 }
 
 }  // namespace
