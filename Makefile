@@ -6,6 +6,8 @@
 #               ASan+UBSan (build-fuzz; what CI runs)
 #   make fuzz   build the libFuzzer targets (build-fuzz), run each for
 #               FUZZ_SECONDS on fuzz/corpus/<target>; non-zero on a finding
+#   make check-functions   no function in src/ over 80 lines without a
+#               comment saying why (scripts/long_functions.py)
 BUILD_DIR ?= build
 JOBS ?= $(shell nproc)
 DEMO_DIR ?= out/demo
@@ -15,7 +17,7 @@ DEMO_DIR ?= out/demo
 DEB_PACKAGES = cmake ninja-build g++ pkg-config libopencv-dev libeigen3-dev \
   libceres-dev libtbb-dev libyaml-cpp-dev nlohmann-json3-dev libcli11-dev \
   libtinygltf-dev libstb-dev libgtest-dev libgmock-dev libbenchmark-dev \
-  colmap help2man \
+  colmap help2man python3 \
   librosbag-dev libsensor-msgs-dev libnav-msgs-dev libtf2-msgs-dev \
   libgeometry-msgs-dev libsqlite3-dev libfastcdr-dev \
   libroscpp-dev libtf2-ros-dev libstd-srvs-dev ros-core \
@@ -34,7 +36,7 @@ FUZZ_TARGETS = camera_yaml camera_mount dataset feature_table image map ply
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
 .PHONY: deps sanitize-deps configure build test test-sanitize fuzz-configure \
-  test-sanitize-parsers fuzz demo bench clean
+  test-sanitize-parsers fuzz check-functions demo bench clean
 
 deps:
 	@missing=$$(for p in $(DEB_PACKAGES); do \
@@ -115,6 +117,9 @@ fuzz: fuzz-configure
 	  then grep -E "INITED|DONE|number_of_executed_units" $(FUZZ_DIR)/$$t.log; \
 	  else status=1; tail -n 80 $(FUZZ_DIR)/$$t.log; fi; \
 	done; exit $$status
+
+check-functions: deps
+	python3 scripts/long_functions.py 80 --check
 
 demo: build
 	$(BUILD_DIR)/src/monomap/exe/monomap demo -o $(DEMO_DIR)

@@ -289,19 +289,86 @@ nlohmann::json IntrinsicsJson(const IntrinsicsRefinementReport& r) {
           {"covariance_seconds", r.covariance_seconds}};
 }
 
+nlohmann::json TrackingJson(const TrackingReport& tracking) {
+  return {{"tracks", tracking.tracks_returned},
+          {"tracks_created", tracking.tracks_created},
+          {"mean_track_length", tracking.mean_track_length},
+          {"mean_features_per_frame", tracking.mean_features_per_frame},
+          {"affine_refined", tracking.refined},
+          {"reference_patches_renewed", tracking.reanchored},
+          {"seconds", tracking.seconds}};
+}
+
+nlohmann::json BundleAdjustmentJson(const BundleAdjustmentReport& ba) {
+  return {{"termination", ba.termination},
+          {"poses", ba.num_poses},
+          {"residuals", ba.num_residuals},
+          {"span_priors", ba.num_span_priors},
+          {"points_joint", ba.num_points_joint},
+          {"initial_rms_reprojection_error_px", ba.initial_rms_error_px},
+          {"final_rms_reprojection_error_px", ba.final_rms_error_px},
+          {"initial_median_reprojection_error_px", ba.initial_median_error_px},
+          {"final_median_reprojection_error_px", ba.final_median_error_px},
+          {"iterations", ba.iterations},
+          {"covisibility", ba.covisibility},
+          {"distortion", ba.distortion},
+          {"linear_solver", ba.linear_solver},
+          {"points_dropped", ba.num_dropped},
+          {"mean_pose_change_m", ba.mean_pose_change_m},
+          {"mean_pose_change_deg", ba.mean_pose_change_deg},
+          {"intrinsics", IntrinsicsJson(ba.intrinsics)}};
+}
+
+nlohmann::json PlanesJson(const PlaneFittingReport& planes) {
+  nlohmann::json j = {{"planes", planes.num_planes},
+                      {"outliers", planes.num_outliers},
+                      {"absorbed_outliers", planes.absorbed},
+                      {"inliers_per_plane", planes.inliers_per_plane}};
+  // Segments merged into one plane (ids as fitted), empty unless merging is on.
+  j["merges"] = nlohmann::json::array();
+  for (const auto& m : planes.merges) {
+    j["merges"].push_back({{"kept_id", m.kept_id},
+                           {"merged_id", m.merged_id},
+                           {"angle_deg", m.angle_deg},
+                           {"offset_m", m.offset_m}});
+  }
+  return j;
+}
+
+nlohmann::json MosaicsJson(const MosaicReport& mosaic) {
+  nlohmann::json mosaics = nlohmann::json::array();
+  for (const auto& m : mosaic.planes) {
+    mosaics.push_back(
+        {{"plane_id", m.plane_id},
+         {"pixels_per_meter", m.pixels_per_meter},
+         {"width", m.width},
+         {"height", m.height},
+         {"frames", m.frames},
+         {"coverage", m.coverage},
+         {"features", m.num_features},
+         {"feature_residual_median_px", m.feature_residual_median_px},
+         {"feature_residual_max_px", m.feature_residual_max_px}});
+  }
+  return mosaics;
+}
+
+nlohmann::json ExportedPointsJson(const PointTrustReport& point_trust) {
+  return {{"points", point_trust.num_points},
+          {"exported", point_trust.num_exported},
+          {"keep_all_points", point_trust.keep_all},
+          // Per reason: left out, or with keep_all_points exported untrusted.
+          {point_trust.keep_all ? "untrusted_kept" : "left_out",
+           {{"short_track", point_trust.short_track},
+            {"reprojection_error", point_trust.reprojection_error},
+            {"triangulation_angle", point_trust.triangulation_angle}}}};
+}
+
 }  // namespace
 
 nlohmann::json MappingReport::ToJson() const {
   nlohmann::json j;
   j["num_frames"] = num_frames;
-  j["tracking"] = {
-      {"tracks", tracking.tracks_returned},
-      {"tracks_created", tracking.tracks_created},
-      {"mean_track_length", tracking.mean_track_length},
-      {"mean_features_per_frame", tracking.mean_features_per_frame},
-      {"affine_refined", tracking.refined},
-      {"reference_patches_renewed", tracking.reanchored},
-      {"seconds", tracking.seconds}};
+  j["tracking"] = TrackingJson(tracking);
   j["observations_beyond_radius"] = observations_beyond_radius;
   j["triangulation"] = {
       {"tracks_in", triangulation.num_tracks},
@@ -320,70 +387,16 @@ nlohmann::json MappingReport::ToJson() const {
       {"rejected_angle", retriangulation.rejected_angle},
       {"mean_reprojection_error_px",
        retriangulation.mean_reprojection_error_px}};
-  j["bundle_adjustment"] = {
-      {"termination", bundle_adjustment.termination},
-      {"poses", bundle_adjustment.num_poses},
-      {"residuals", bundle_adjustment.num_residuals},
-      {"span_priors", bundle_adjustment.num_span_priors},
-      {"points_joint", bundle_adjustment.num_points_joint},
-      {"initial_rms_reprojection_error_px",
-       bundle_adjustment.initial_rms_error_px},
-      {"final_rms_reprojection_error_px", bundle_adjustment.final_rms_error_px},
-      {"initial_median_reprojection_error_px",
-       bundle_adjustment.initial_median_error_px},
-      {"final_median_reprojection_error_px",
-       bundle_adjustment.final_median_error_px},
-      {"iterations", bundle_adjustment.iterations},
-      {"covisibility", bundle_adjustment.covisibility},
-      {"distortion", bundle_adjustment.distortion},
-      {"linear_solver", bundle_adjustment.linear_solver},
-      {"points_dropped", bundle_adjustment.num_dropped},
-      {"mean_pose_change_m", bundle_adjustment.mean_pose_change_m},
-      {"mean_pose_change_deg", bundle_adjustment.mean_pose_change_deg},
-      {"intrinsics", IntrinsicsJson(bundle_adjustment.intrinsics)}};
-  nlohmann::json planes_json = {
-      {"planes", planes.num_planes},
-      {"outliers", planes.num_outliers},
-      {"absorbed_outliers", planes.absorbed},
-      {"inliers_per_plane", planes.inliers_per_plane}};
-  // Segments merged into one plane (ids as fitted), empty unless merging is on.
-  planes_json["merges"] = nlohmann::json::array();
-  for (const auto& m : planes.merges) {
-    planes_json["merges"].push_back({{"kept_id", m.kept_id},
-                                     {"merged_id", m.merged_id},
-                                     {"angle_deg", m.angle_deg},
-                                     {"offset_m", m.offset_m}});
-  }
-  j["planes"] = planes_json;
+  j["bundle_adjustment"] = BundleAdjustmentJson(bundle_adjustment);
+  j["planes"] = PlanesJson(planes);
   j["homographies"] = {
       {"count", homographies.num_homographies},
       {"checked", homographies.num_checked},
       {"refined", homographies.num_refined},
       {"median_residual_before_px", homographies.median_residual_before_px},
       {"median_residual_after_px", homographies.median_residual_after_px}};
-  nlohmann::json mosaics = nlohmann::json::array();
-  for (const auto& m : mosaic.planes) {
-    mosaics.push_back(
-        {{"plane_id", m.plane_id},
-         {"pixels_per_meter", m.pixels_per_meter},
-         {"width", m.width},
-         {"height", m.height},
-         {"frames", m.frames},
-         {"coverage", m.coverage},
-         {"features", m.num_features},
-         {"feature_residual_median_px", m.feature_residual_median_px},
-         {"feature_residual_max_px", m.feature_residual_max_px}});
-  }
-  j["mosaics"] = mosaics;
-  j["exported_points"] = {
-      {"points", point_trust.num_points},
-      {"exported", point_trust.num_exported},
-      {"keep_all_points", point_trust.keep_all},
-      // Per reason: left out, or with keep_all_points exported untrusted.
-      {point_trust.keep_all ? "untrusted_kept" : "left_out",
-       {{"short_track", point_trust.short_track},
-        {"reprojection_error", point_trust.reprojection_error},
-        {"triangulation_angle", point_trust.triangulation_angle}}}};
+  j["mosaics"] = MosaicsJson(mosaic);
+  j["exported_points"] = ExportedPointsJson(point_trust);
   nlohmann::json t = nlohmann::json::object();
   for (const auto& s : timings) t[s.name] = s.seconds;
   j["timings_seconds"] = t;
