@@ -301,6 +301,9 @@ TEST(BadImport, TumSequences) {
       {"first_image_truncated",
        [first](const fs::path& d) { CutInHalf(d / first); },
        "999.800000.png: truncated PNG"},
+      {"later_image_truncated",
+       [](const fs::path& d) { CutInHalf(d / "rgb" / "1000.466667.png"); },
+       "INPUT/rgb.txt:24: INPUT/rgb/1000.466667.png: truncated PNG"},
       {"first_image_header_huge",
        [first](const fs::path& d) { ClaimPngSize(d / first, 100000); },
        "999.800000.png: image size 100000x100000 exceeds the limit"},
@@ -401,6 +404,9 @@ TEST(BadImport, KittiSequences) {
       {"first_image_truncated",
        [at](const fs::path& d) { CutInHalf(at(d, "image_0/000000.png")); },
        "000000.png: truncated PNG"},
+      {"later_image_truncated",
+       [at](const fs::path& d) { CutInHalf(at(d, "image_0/000005.png")); },
+       seq + "times.txt:6: " + seq + "image_0/000005.png: truncated PNG"},
   };
   test::RunCatalogue(kRoot, "dataset",
                      "import kitti INPUT/sequences/07 -o OUT -q --poses "

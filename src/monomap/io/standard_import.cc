@@ -1,5 +1,7 @@
 #include "monomap/io/standard_import.h"
 
+#include <tbb/parallel_for.h>
+
 #include <cmath>
 #include <cstdio>
 #include <opencv2/imgcodecs.hpp>
@@ -179,6 +181,36 @@ void CheckTimesIncrease(const PosedImages& in) {
   }
 }
 
+// Every imported image must decode completely and have the camera's size:
+// a truncated frame found here fails the import, naming its list line,
+// instead of a later build. Decoded in parallel (grey: for JPEG the cheap
+// decode); the first bad image in list order is reported.
+void CheckImagesDecode(const PosedImages& in,
+                       const std::vector<const TumImage*>& used,
+                       const Camera& camera) {
+  std::vector<std::string> errors(used.size());
+  tbb::parallel_for(size_t{0}, used.size(), [&](size_t k) {
+    const fs::path path = in.root / used[k]->path;
+    try {
+      const cv::Mat image = ReadImageFile(path, cv::IMREAD_GRAYSCALE);
+      if (image.cols != camera.width || image.rows != camera.height) {
+        errors[k] = path.string() + ": image is " +
+                    std::to_string(image.cols) + "x" +
+                    std::to_string(image.rows) + ", the camera " +
+                    std::to_string(camera.width) + "x" +
+                    std::to_string(camera.height);
+      }
+    } catch (const InputError& e) {
+      errors[k] = e.what();
+    }
+  });
+  for (size_t k = 0; k < used.size(); ++k) {
+    if (!errors[k].empty()) {
+      throw InputError(in.list.string(), used[k]->line, errors[k]);
+    }
+  }
+}
+
 // Interpolates a pose for every image (dropping those without one), links
 // the images, simulates odometry if `simulate`, and writes the dataset.
 ImportReport ImportPosedImages(const PosedImages& in, const Camera& camera,
@@ -193,6 +225,7 @@ ImportReport ImportPosedImages(const PosedImages& in, const Camera& camera,
   AtomicDirectory out(out_dir, "dataset");
   std::vector<ImportedFrame> frames;
   std::vector<Rigid3d> poses;
+  std::vector<const TumImage*> used;
   for (const TumImage& im : in.images) {
     Rigid3d pose;
     if (!InterpolatePose(in.trajectory, im.timestamp, max_pose_gap, &pose)) {
@@ -208,11 +241,13 @@ ImportReport ImportPosedImages(const PosedImages& in, const Camera& camera,
     LinkOrCopy(in.root / im.path, out.path() / name);
     frames.push_back({im.timestamp, name, pose, std::nullopt, std::nullopt});
     poses.push_back(pose);
+    used.push_back(&im);
   }
   if (frames.empty()) {
     throw InputError(in.list.string() +
                      ": no image lies within the trajectory's time span");
   }
+  CheckImagesDecode(in, used, camera);
   if (simulate) {
     const std::vector<Rigid3d> odo = SimulateOdometry(poses, sim);
     for (size_t k = 0; k < frames.size(); ++k) {
