@@ -11,7 +11,9 @@
 // time, in cores); the share of updates in each status (relocalizing and lost
 // are false alarms on a sequence without kidnapping); and, with ground truth,
 // the errors of the processed frames and, for a global start, when the
-// filter converged (frame and seconds after the first frame).
+// filter converged (frame and seconds after the first frame); and the
+// steady state apart from the start-up (the first update's time, the
+// frames dropped during it, and drops and latency after it).
 //
 //   build/bench/realtime_replay MAP DATASET --state 6dof --method mcc
 //       --threads 1 --first-frame 150 --out /tmp/rt.json
@@ -21,6 +23,8 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
+#include <map>
+#include <set>
 #include <cstdio>
 #include <mutex>
 #include <nlohmann/json.hpp>
@@ -151,6 +155,41 @@ nlohmann::json Summarize(const std::vector<SessionResult>& results,
           {"lost_fraction", lost / n}};
 }
 
+// The first update weighs and corrects the whole initial particle set and
+// takes many frame periods; the frames that arrive meanwhile are dropped
+// once. The steady state (frames arriving after the first pose) is reported
+// apart from that start-up: drops and latency.
+void AddSteadyState(const std::vector<SessionFrame>& frames, double fps,
+                    const std::vector<SessionResult>& results,
+                    const SessionCounters& c, nlohmann::json* j) {
+  if (results.empty() || frames.empty()) return;
+  std::map<double, double> arrival;  // stamp -> seconds after the first
+  for (size_t i = 0; i < frames.size(); ++i) {
+    arrival[frames[i].stamp] =
+        fps > 0 ? i / fps : frames[i].stamp - frames[0].stamp;
+  }
+  const double first_done =
+      arrival[results[0].stamp] + results[0].latency_seconds;
+  std::set<double> processed;
+  std::vector<double> latency;
+  for (const SessionResult& r : results) {
+    processed.insert(r.stamp);
+    if (arrival[r.stamp] > first_done) latency.push_back(r.latency_seconds);
+  }
+  int steady = 0, steady_dropped = 0;
+  for (const auto& [stamp, at] : arrival) {
+    if (at <= first_done) continue;
+    ++steady;
+    steady_dropped += processed.count(stamp) ? 0 : 1;
+  }
+  (*j)["first_update_ms"] = 1e3 * results[0].stats.seconds;
+  (*j)["startup_dropped"] = c.dropped - steady_dropped;
+  (*j)["steady_frames"] = steady;
+  (*j)["steady_dropped"] = steady_dropped;
+  (*j)["steady_latency_mean_ms"] = 1e3 * Mean(latency);
+  (*j)["steady_latency_p95_ms"] = 1e3 * Percentile(latency, 0.95);
+}
+
 void AddAccuracy(const Dataset& dataset,
                  const std::vector<SessionResult>& results, nlohmann::json* j) {
   std::vector<TimedPose> estimate, truth;
@@ -194,6 +233,7 @@ int Run(const ReplayArgs& a) {
   const double cpu = ProcessCpuSeconds() - cpu0;
   session->Stop();
   nlohmann::json j = Summarize(results, session->counters(), wall, cpu);
+  AddSteadyState(frames, a.fps, results, session->counters(), &j);
   AddAccuracy(dataset, results, &j);
   j["map"] = a.map_dir;
   j["dataset"] = a.dataset;
