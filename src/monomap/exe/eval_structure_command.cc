@@ -35,14 +35,6 @@ void CheckAlignmentArgs(const StructureArgs& a) {
   }
 }
 
-Alignment StructureAlignment(const std::string& name) {
-  if (name == "first-pose") return Alignment::kFirstPose;
-  if (name == "se3") return Alignment::kSE3;
-  if (name == "sim3") return Alignment::kSim3;
-  if (name == "sim3-poses") return Alignment::kSim3Poses;
-  return Alignment::kNone;
-}
-
 // Relative point errors divide by each landmark's mean depth, which
 // points.ply does not hold: recompute it from the feature table. Returns
 // false (depth: distance to the nearest camera) if the map has none.
@@ -69,9 +61,9 @@ void RunEvalStructure(const StructureArgs& a) {
   const bool have_features = SetDepthsFromFeatures(a.map_dir, &map);
   Sim3d truth_from_map;
   if (a.align != "none") {
-    truth_from_map =
-        AlignTrajectories(map.trajectory, ReadTumTrajectory(a.groundtruth),
-                          StructureAlignment(a.align));
+    truth_from_map = AlignTrajectories(
+        map.trajectory, ReadTumTrajectory(a.groundtruth),
+        ParseAlignment(a.align == "first-pose" ? "first" : a.align));
   }
   // gt ~ scale * R * x + t: scale the map, then move it rigidly.
   if (truth_from_map.scale != 1.0) {
