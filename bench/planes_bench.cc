@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "monomap/planes/plane_fitting.h"
+#include "monomap/util/random.h"
 
 namespace monomap {
 namespace {
@@ -35,8 +36,9 @@ std::vector<Landmark> MakeLandmarks(int num_points) {
   for (const auto& r : rects) {
     const int count = static_cast<int>(r.share * num_inliers);
     for (int i = 0; i < count; ++i) {
-      push(r.origin + uni(rng) * r.u + uni(rng) * r.v +
-           Eigen::Vector3d(noise(rng), noise(rng), noise(rng)));
+      const auto n = DrawLastFirst<Eigen::Vector3d>(noise, rng);
+      const double v = uni(rng);
+      push(r.origin + uni(rng) * r.u + v * r.v + n);
     }
   }
   while (static_cast<int>(lms.size()) < num_points) {

@@ -69,9 +69,10 @@ cv::Mat RandomTexture(int cols, int rows, uint64_t seed) {
   grey.convertTo(grey, CV_8U);
   for (int i = 0; i < 60; ++i) {
     const int x = rng.uniform(0, cols), y = rng.uniform(0, rows);
-    cv::rectangle(grey, cv::Rect(x, y, rng.uniform(5, cols / 8),
-                                 rng.uniform(5, rows / 8)),
-                  cv::Scalar(rng.uniform(0, 256)), cv::FILLED);
+    // Draws in gcc's order of the arguments (util/random.h).
+    const int fill = rng.uniform(0, 256), h = rng.uniform(5, rows / 8);
+    cv::rectangle(grey, cv::Rect(x, y, rng.uniform(5, cols / 8), h),
+                  cv::Scalar(fill), cv::FILLED);
   }
   cv::Mat bgra;
   cv::cvtColor(grey, bgra, cv::COLOR_GRAY2BGRA);
@@ -107,9 +108,10 @@ Scene MakeDesk() {
   Scene scene{Renderer(planes), {}};
   cv::RNG rng(7);
   for (int i = 0; i < kBatch; ++i) {
-    const Vector3d centre(rng.uniform(0.1, 0.7), rng.uniform(-0.2, 0.4),
-                          rng.uniform(0.3, 0.6));
-    const Vector3d target(rng.uniform(0.25, 0.55), rng.uniform(0.2, 0.4), 0);
+    const double cz = rng.uniform(0.3, 0.6), cy = rng.uniform(-0.2, 0.4);
+    const Vector3d centre(rng.uniform(0.1, 0.7), cy, cz);
+    const double ty = rng.uniform(0.2, 0.4);
+    const Vector3d target(rng.uniform(0.25, 0.55), ty, 0);
     const double a = rng.uniform(0.0, 2 * M_PI);
     scene.poses.push_back(
         LookAt(centre, target, Vector3d(std::cos(a), std::sin(a), 0)));
@@ -139,8 +141,8 @@ Scene MakeHallway() {
   Scene scene{Renderer(planes), {}};
   cv::RNG rng(11);
   for (int i = 0; i < kBatch; ++i) {
-    const Vector3d centre(rng.uniform(0.5, 6.0), rng.uniform(-0.6, 0.6),
-                          rng.uniform(1.2, 1.7));
+    const double cz = rng.uniform(1.2, 1.7), cy = rng.uniform(-0.6, 0.6);
+    const Vector3d centre(rng.uniform(0.5, 6.0), cy, cz);
     const double yaw = rng.uniform(-0.5, 0.5);
     const double pitch = rng.uniform(-0.2, 0.2);
     const Vector3d dir(std::cos(yaw) * std::cos(pitch),
@@ -235,11 +237,10 @@ MapScene LoadMapScene(const std::string& dir) {
   for (int i = 0; i < kBatch; ++i) {
     const Rigid3d& at =
         map.trajectory[i % map.trajectory.size()].world_from_cam;
-    const Vector3d shift(rng.uniform(-0.02, 0.02), rng.uniform(-0.02, 0.02),
-                         rng.uniform(-0.02, 0.02));
-    const Vector3d axis =
-        Vector3d(rng.gaussian(1), rng.gaussian(1), rng.gaussian(1))
-            .normalized();
+    Vector3d shift, axis;  // last element drawn first (util/random.h)
+    for (int k = 2; k >= 0; --k) shift[k] = rng.uniform(-0.02, 0.02);
+    for (int k = 2; k >= 0; --k) axis[k] = rng.gaussian(1);
+    axis.normalize();
     const double angle = DegToRadMulDiv(rng.uniform(0.0, 2.0));
     scene.poses.emplace_back(
         at.rotation * Eigen::Quaterniond(Eigen::AngleAxisd(angle, axis)),

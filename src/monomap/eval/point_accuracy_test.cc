@@ -8,6 +8,7 @@
 #include <random>
 
 #include "monomap/util/error.h"
+#include "monomap/util/random.h"
 
 namespace monomap {
 namespace {
@@ -123,7 +124,7 @@ std::vector<Eigen::Vector3d> RandomQueries(std::mt19937& rng, int n,
                                            double lo, double hi) {
   std::uniform_real_distribution<double> u(lo, hi);
   std::vector<Eigen::Vector3d> q(n);
-  for (auto& x : q) x = Eigen::Vector3d(u(rng), u(rng), u(rng));
+  for (auto& x : q) x = DrawLastFirst<Eigen::Vector3d>(u, rng);
   return q;
 }
 
@@ -140,10 +141,13 @@ TEST(NearestNeighborIndexTest, SurfaceCloudMatchesBruteForce) {
   std::uniform_real_distribution<double> u(-2.0, 2.0);
   std::normal_distribution<double> g(0.0, 1.0);
   std::vector<Eigen::Vector3d> cloud;
-  for (int i = 0; i < 30000; ++i) cloud.emplace_back(u(rng), u(rng), 0.0);
+  for (int i = 0; i < 30000; ++i) {
+    const double y = u(rng);
+    cloud.emplace_back(u(rng), y, 0.0);
+  }
   for (int i = 0; i < 20000; ++i) {
     cloud.push_back(Eigen::Vector3d(0.5, 0.3, 1.0) +
-                    0.7 * Eigen::Vector3d(g(rng), g(rng), g(rng)).normalized());
+                    0.7 * DrawLastFirst<Eigen::Vector3d>(g, rng).normalized());
   }
   ExpectMatchesBruteForce(cloud, RandomQueries(rng, 1000, -2.5, 2.5));
 }
@@ -157,7 +161,7 @@ TEST(NearestNeighborIndexTest, ClusteredAndDegenerateClouds) {
     const Eigen::Vector3d centre(10.0 * c, -5.0 * c, 2.0 * c);
     for (int i = 0; i < 2000; ++i) {
       clusters.push_back(centre +
-                         0.01 * Eigen::Vector3d(g(rng), g(rng), g(rng)));
+                         0.01 * DrawLastFirst<Eigen::Vector3d>(g, rng));
     }
   }
   ExpectMatchesBruteForce(clusters, RandomQueries(rng, 1000, -5.0, 45.0));
@@ -165,7 +169,8 @@ TEST(NearestNeighborIndexTest, ClusteredAndDegenerateClouds) {
   std::vector<Eigen::Vector3d> planar;
   std::uniform_real_distribution<double> u(0.0, 1.0);
   for (int i = 0; i < 5000; ++i) {
-    planar.emplace_back(u(rng), u(rng), 0.0);
+    const double y = u(rng);
+    planar.emplace_back(u(rng), y, 0.0);
     if (i % 10 == 0) planar.push_back(planar.back());
   }
   ExpectMatchesBruteForce(planar, RandomQueries(rng, 1000, -0.5, 1.5));

@@ -7,6 +7,7 @@
 
 #include "monomap/util/angles.h"
 #include "monomap/util/error.h"
+#include "monomap/util/random.h"
 
 namespace monomap {
 namespace {
@@ -45,10 +46,10 @@ std::vector<TimedPose> Transformed(const std::vector<TimedPose>& gt,
     Rigid3d& w = p.world_from_cam;
     w.translation = scale * (kWorldChange.rotation * w.translation) +
                     kWorldChange.translation +
-                    sigma_t * Eigen::Vector3d(g(rng), g(rng), g(rng));
+                    sigma_t * DrawLastFirst<Eigen::Vector3d>(g, rng);
     w.rotation = (kWorldChange.rotation * w.rotation *
                   QuaternionFromRotationVector(
-                      sigma_r * Eigen::Vector3d(g(rng), g(rng), g(rng))))
+                      sigma_r * DrawLastFirst<Eigen::Vector3d>(g, rng)))
                      .normalized();
   }
   return est;

@@ -21,7 +21,9 @@ TEST(Plane, LeastSquaresRecoversNoisyPlane) {
                                       Eigen::Vector3d::UnitX());
   std::vector<Eigen::Vector3d> pts;
   for (int i = 0; i < 500; ++i) {
-    pts.push_back(f.ToWorld({uni(rng), uni(rng)}) + noise(rng) * truth.normal);
+    const double n = noise(rng);
+    const Eigen::Vector2d st{uni(rng), uni(rng)};
+    pts.push_back(f.ToWorld(st) + n * truth.normal);
   }
   const Plane fit = FitPlaneLeastSquares(pts);
   EXPECT_LT(PlaneAngle(fit, truth), DegToRad(0.2));

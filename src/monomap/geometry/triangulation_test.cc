@@ -1,4 +1,5 @@
 #include "monomap/geometry/triangulation.h"
+#include "monomap/util/random.h"
 
 #include <gtest/gtest.h>
 
@@ -24,7 +25,7 @@ TEST(TriangulateLinear, ExactAndNoisy) {
   Eigen::Vector3d est;
   ASSERT_TRUE(TriangulateLinear(cams, obs, &est));
   EXPECT_LT((est - x).norm(), 1e-9);
-  for (auto& o : obs) o += Eigen::Vector2d(noise(rng), noise(rng));
+  for (auto& o : obs) o += DrawLastFirst<Eigen::Vector2d>(noise, rng);
   ASSERT_TRUE(TriangulateLinear(cams, obs, &est));
   EXPECT_LT((est - x).norm(), 0.05);  // ~1.7% of depth at 0.5 px noise
   const double angle = MaxTriangulationAngle(cams, x);

@@ -10,6 +10,7 @@
 
 #include "monomap/util/error.h"
 #include "monomap/util/file.h"
+#include "monomap/util/random.h"
 
 namespace monomap {
 namespace {
@@ -63,7 +64,7 @@ Scene MakeScene(const std::array<double, 5>& distortion, double noise_px) {
           s.map.camera.ImageFromCam(cam_from_world * l.x_in_world);
       if (!s.map.camera.InImage(px)) continue;
       t.observations.push_back(
-          {f, px + Eigen::Vector2d(noise(rng), noise(rng))});
+          {f, px + DrawLastFirst<Eigen::Vector2d>(noise, rng)});
     }
     s.map.landmarks.push_back(l);
     s.tracks.push_back(t);

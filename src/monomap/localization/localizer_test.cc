@@ -36,10 +36,10 @@ Drive MakeDrive(const Pose2d& start, int steps, double step_m,
   d.odometry.push_back({0, 0, 0});  // odometry has its own origin
   for (int i = 1; i < steps; ++i) {
     d.truth.push_back(Compose(d.truth.back(), step_m, 0, turn_rad));
-    d.odometry.push_back(Compose(d.odometry.back(),
-                                 step_m * (1.05 + 0.02 * n(rng)),
-                                 0.002 * n(rng),
-                                 turn_rad * 1.1 + 0.002 * n(rng)));
+    const double dyaw = turn_rad * 1.1 + 0.002 * n(rng);
+    const double dy = 0.002 * n(rng);
+    const double dx = step_m * (1.05 + 0.02 * n(rng));
+    d.odometry.push_back(Compose(d.odometry.back(), dx, dy, dyaw));
   }
   return d;
 }

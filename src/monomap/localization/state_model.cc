@@ -108,8 +108,9 @@ Particle SixDofStateModel::Random(const SamplingArea& area,
   // Keep height, roll and pitch of the reference; draw x, y and yaw.
   const Eigen::Quaterniond q = YawRotation(uyaw(*rng)) * ref.rotation;
   Particle p;
+  const double y = uy(*rng);  // y before x: see util/random.h
   p.world_from_cam =
-      Rigid3d(q, Eigen::Vector3d(ux(*rng), uy(*rng), ref.translation.z()));
+      Rigid3d(q, Eigen::Vector3d(ux(*rng), y, ref.translation.z()));
   return p;
 }
 

@@ -8,6 +8,7 @@
 #include <random>
 
 #include "monomap/util/error.h"
+#include "monomap/util/random.h"
 
 namespace monomap {
 namespace {
@@ -79,28 +80,32 @@ Scene MakeScene(uint64_t seed) {
     scene.label.push_back(label);
   };
   auto jitter = [&]() {
-    return Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
+    return DrawLastFirst<Eigen::Vector3d>(noise, rng);
   };
   for (size_t r = 0; r < scene.regions.size(); ++r) {
     const auto& reg = scene.regions[r];
     for (int i = 0; i < reg.count; ++i) {
-      const Eigen::Vector2d st(reg.w * uni(rng), reg.h * uni(rng));
+      const Eigen::Vector2d st = Eigen::Vector2d(reg.w, reg.h).cwiseProduct(
+          DrawLastFirst<Eigen::Vector2d>(uni, rng));
       push(reg.frame.ToWorld(st) + jitter(), static_cast<int>(r));
     }
   }
   // Mug: radius 4 cm, 10 cm tall, 2 cm above the floor.
   for (int i = 0; i < 200; ++i) {
     const double a = 2 * kPi * uni(rng);
+    const Eigen::Vector3d j = jitter();
+    const double z = 0.02 + 0.10 * uni(rng);
     push(Eigen::Vector3d(2.0 + 0.04 * std::cos(a), 1.5 + 0.04 * std::sin(a),
-                         0.02 + 0.10 * uni(rng)) +
-             jitter(),
+                         z) +
+             j,
          kBlob);
   }
   // 20% of all points are outliers in the box around the scene.
   const int num_outliers = static_cast<int>(scene.landmarks.size()) / 4;
   for (int i = 0; i < num_outliers; ++i) {
-    push(Eigen::Vector3d(-0.2 + 3.4 * uni(rng), -0.2 + 3.2 * uni(rng),
-                         -0.2 + 2.4 * uni(rng)),
+    const Eigen::Vector3d u = DrawLastFirst<Eigen::Vector3d>(uni, rng);
+    push(Eigen::Vector3d(-0.2 + 3.4 * u[0], -0.2 + 3.2 * u[1],
+                         -0.2 + 2.4 * u[2]),
          kOutlier);
   }
   return scene;
@@ -219,7 +224,7 @@ TEST(FitPlanes, PlaneThroughSeveralSmallObjectsIsRejected) {
   auto push = [&](const Eigen::Vector3d& x, bool floor) {
     Landmark lm;
     lm.id = static_cast<FeatureId>(lms.size());
-    lm.x_in_world = x + Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
+    lm.x_in_world = x + DrawLastFirst<Eigen::Vector3d>(noise, rng);
     lm.mean_depth_m = 0.5;
     lms.push_back(lm);
     on_floor.push_back(floor);
@@ -345,7 +350,7 @@ TEST(FitPlanes, ConcaveOutlineFollowsAnLShape) {
   std::uniform_real_distribution<double> uni(0.0, 2.0);
   std::vector<Landmark> lms;
   while (lms.size() < 3000) {
-    const Eigen::Vector2d p(uni(rng), uni(rng));
+    const auto p = DrawLastFirst<Eigen::Vector2d>(uni, rng);
     if (p.x() > 1.0 && p.y() > 1.0) continue;
     Landmark lm;
     lm.id = static_cast<FeatureId>(lms.size());
@@ -374,7 +379,7 @@ TEST(FitPlanes, NoiseOnlyGivesNoPlanes) {
   std::uniform_real_distribution<double> uni(0.0, 2.0);
   std::vector<Landmark> lms(1500);
   for (auto& lm : lms) {
-    lm.x_in_world = Eigen::Vector3d(uni(rng), uni(rng), uni(rng));
+    lm.x_in_world = DrawLastFirst<Eigen::Vector3d>(uni, rng);
     lm.mean_depth_m = 0.5;
     lm.plane_id = 7;
   }

@@ -6,6 +6,7 @@
 
 #include "monomap/util/angles.h"
 #include "monomap/util/error.h"
+#include "monomap/util/random.h"
 
 namespace monomap::testing {
 namespace {
@@ -40,8 +41,8 @@ TestScene MakePointScene(const TestSceneOptions& options) {
     const int mid = std::min(start + length / 2, n - 1);
     // A pixel in the central part of the middle view, so the point stays in
     // the image over the whole track, back-projected to a random depth.
-    const Eigen::Vector2d px(camera.cx + (uniform(rng) - 0.5) * 440.0,
-                             camera.cy + (uniform(rng) - 0.5) * 360.0);
+    const double v = camera.cy + (uniform(rng) - 0.5) * 360.0;
+    const Eigen::Vector2d px(camera.cx + (uniform(rng) - 0.5) * 440.0, v);
     const double depth =
         p.min_depth_m + uniform(rng) * (p.max_depth_m - p.min_depth_m);
     const Eigen::Vector3d x_in_cam =
@@ -54,7 +55,7 @@ TestScene MakePointScene(const TestSceneOptions& options) {
       if (xc.z() <= 0) continue;
       Eigen::Vector2d obs = camera.ImageFromCam(xc);
       if (!camera.InImage(obs, 2.0)) continue;
-      obs += p.pixel_noise_px * Eigen::Vector2d(noise(rng), noise(rng));
+      obs += p.pixel_noise_px * DrawLastFirst<Eigen::Vector2d>(noise, rng);
       track.observations.push_back({f, obs});
     }
     scene.points.push_back(x);
@@ -169,11 +170,11 @@ std::vector<Rigid3d> SimulateOdometryDrift(
     const Eigen::Vector3d t =
         (1.0 + options.scale_error) * delta.translation +
         options.translation_noise_fraction * step *
-            Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
+            DrawLastFirst<Eigen::Vector3d>(noise, rng);
     const Eigen::Vector3d w =
         drift_axis * DegToRad(options.rotation_drift_deg_per_m * step) +
         DegToRad(options.rotation_noise_deg) *
-            Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
+            DrawLastFirst<Eigen::Vector3d>(noise, rng);
     const Rigid3d noisy(delta.rotation * QuaternionFromRotationVector(w), t);
     odometry.push_back(odometry.back() * noisy);
   }

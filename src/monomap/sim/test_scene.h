@@ -36,6 +36,7 @@
 #include "monomap/map/map.h"
 #include "monomap/rendering/renderer.h"
 #include "monomap/util/angles.h"
+#include "monomap/util/random.h"
 
 namespace monomap::testing {
 
@@ -80,9 +81,11 @@ struct ProceduralTexture {
     std::uniform_real_distribution<double> u(0.0, 1.0);
     for (int i = 0; i < num_blobs; ++i) {
       Blob b;
-      b.centre = lo + (hi - lo).cwiseProduct(Eigen::Vector2d(u(rng), u(rng)));
+      b.centre = lo + (hi - lo).cwiseProduct(
+                          DrawLastFirst<Eigen::Vector2d>(u, rng));
       b.radius = 0.01 + 0.03 * u(rng);
-      b.bgr = Eigen::Vector3f(u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5) * 160;
+      const Eigen::Vector3d c = DrawLastFirst<Eigen::Vector3d>(u, rng);
+      b.bgr = Eigen::Vector3f(c[0] - 0.5, c[1] - 0.5, c[2] - 0.5) * 160;
       t.blobs.push_back(b);
     }
     return t;
@@ -218,7 +221,8 @@ inline void MakePlaneFeatures(const Camera& camera,
     l.id = first_id + i;
     const Eigen::Vector2d st =
         lo + (hi - lo).cwiseProduct(
-                 Eigen::Vector2d(0.05 + 0.9 * u(rng), 0.05 + 0.9 * u(rng)));
+                 Eigen::Vector2d::Constant(0.05) +
+                 0.9 * DrawLastFirst<Eigen::Vector2d>(u, rng));
     l.x_in_world = segment->frame.ToWorld(st);
     l.plane_id = segment->id;
     segment->inlier_ids.push_back(l.id);
@@ -252,7 +256,8 @@ inline cv::Mat BlobTexture(int cols, int rows, uint64_t seed) {
   grey.convertTo(grey, CV_8U);
   const int blobs = cols * rows / 1500;
   for (int i = 0; i < blobs; ++i) {
-    const cv::Point c(rng.uniform(0, cols), rng.uniform(0, rows));
+    const int y = rng.uniform(0, rows);  // y first: util/random.h
+    const cv::Point c(rng.uniform(0, cols), y);
     const int r = rng.uniform(3, 18);
     cv::circle(grey, c, r, cv::Scalar(rng.uniform(0, 256)), cv::FILLED,
                cv::LINE_AA);

@@ -30,8 +30,16 @@ class Painter {
     return r & cv::Rect(0, 0, img_.cols, img_.rows);
   }
   double U(double a, double b) { return rng_.uniform(a, b); }
+  // Channels drawn last first: the order of the worlds' textures since
+  // their first figures (util/random.h says why it is spelled out).
   cv::Scalar Colour(double lo, double hi) {
-    return cv::Scalar(U(lo, hi), U(lo, hi), U(lo, hi));
+    const double red = U(lo, hi), green = U(lo, hi), blue = U(lo, hi);
+    return cv::Scalar(blue, green, red);
+  }
+  // A pixel uniform in [0, width) x [0, height), y drawn first.
+  cv::Point Pixel(int width, int height) {
+    const int y = rng_.uniform(0, height);
+    return cv::Point(rng_.uniform(0, width), y);
   }
 
   // Band-limited Gaussian noise with features about `cell_m` metres wide,
@@ -113,7 +121,7 @@ class Painter {
     // Shapes are drawn into the poster's sub-image so they stay inside it.
     cv::Mat sub = img_(r);
     for (int i = 0; i < 25; ++i) {
-      const cv::Point c(rng_.uniform(0, r.width), rng_.uniform(0, r.height));
+      const cv::Point c = Pixel(r.width, r.height);
       const int a = std::max(2, static_cast<int>(U(0.02, 0.12) * ppm_));
       const int b = std::max(2, static_cast<int>(U(0.02, 0.12) * ppm_));
       const cv::Scalar col = Colour(0, 230);
@@ -204,7 +212,8 @@ void PaintWall(TexturedPlane* plane, double width, double height,
   Painter p(&img, plane->pixels_per_meter, rng);
   // Painted plaster: mostly low texture, the hard part for trackers.
   const double shade = p.U(190, 225);
-  img.setTo(cv::Scalar(shade - p.U(0, 20), shade - p.U(0, 10), shade));
+  const double green_off = p.U(0, 10), blue_off = p.U(0, 20);
+  img.setTo(cv::Scalar(shade - blue_off, shade - green_off, shade));
   p.AddNoise({0, 0, img.cols, img.rows}, 5.0, 0.8, 0.1);
   p.AddNoise({0, 0, img.cols, img.rows}, 2.0, 0.02, 1.0 / p.ppm());
   // Skirting board.
@@ -224,7 +233,8 @@ void PaintWall(TexturedPlane* plane, double width, double height,
   // A few small notices and switches.
   for (int i = 0; i < 4; ++i) {
     const double s = p.U(0.1, width - 0.3), z = p.U(0.9, 1.5);
-    const cv::Rect r = p.RectM(s, height - z, p.U(0.06, 0.2), p.U(0.08, 0.25));
+    const double rh = p.U(0.08, 0.25), rw = p.U(0.06, 0.2);
+    const cv::Rect r = p.RectM(s, height - z, rw, rh);
     bool free = true;
     for (const auto& [a, b] : used) {
       if (s < b + 0.05 && s + 0.25 > a - 0.05) free = false;
@@ -276,8 +286,9 @@ void PaintFloor(TexturedPlane* plane, double width, double height, bool planks,
     for (double t = 0; t < height; t += tile) {
       for (double s = 0; s < width; s += tile) {
         const double g = p.U(120, 165);
+        const double green_off = p.U(0, 10), blue_off = p.U(0, 15);
         p.Fill(p.RectM(s, t, tile, tile),
-               cv::Scalar(g - p.U(0, 15), g - p.U(0, 10), g));
+               cv::Scalar(g - blue_off, g - green_off, g));
       }
     }
     // Terrazzo speckle: fine, high-contrast corners everywhere.
@@ -290,10 +301,11 @@ void PaintFloor(TexturedPlane* plane, double width, double height, bool planks,
     }
     // Scuffs.
     for (int i = 0; i < static_cast<int>(width * height); ++i) {
-      const cv::Point c(p.rng().uniform(0, img.cols),
-                        p.rng().uniform(0, img.rows));
-      cv::ellipse(img, c, {p.Px(p.U(0.02, 0.1)), p.Px(p.U(0.005, 0.02))},
-                  p.U(0, 180), 0, 360, p.Colour(50, 90), -1, cv::LINE_AA);
+      const cv::Point c = p.Pixel(img.cols, img.rows);
+      const cv::Scalar colour = p.Colour(50, 90);
+      const double angle = p.U(0, 180);
+      const int a = p.Px(p.U(0.02, 0.1)), b = p.Px(p.U(0.005, 0.02));
+      cv::ellipse(img, c, {a, b}, angle, 0, 360, colour, -1, cv::LINE_AA);
     }
   }
   cv::Mat bgr;
@@ -335,17 +347,17 @@ void PaintWhiteboard(TexturedPlane* plane, cv::RNG* rng) {
   const cv::Scalar inks[] = {{150, 40, 20}, {20, 20, 20}, {30, 30, 170},
                              {40, 120, 30}};
   for (int i = 0; i < 8; ++i) {
-    const cv::Rect box(p.rng().uniform(0, img.cols * 2 / 3),
-                       p.rng().uniform(0, img.rows * 3 / 4), img.cols / 3,
-                       img.rows / 4);
+    const cv::Point corner = p.Pixel(img.cols * 2 / 3, img.rows * 3 / 4);
+    const cv::Rect box(corner.x, corner.y, img.cols / 3, img.rows / 4);
     p.Text(box, p.U(0.03, 0.06), inks[i % 4], 3);
   }
   for (int i = 0; i < 6; ++i) {
     std::vector<cv::Point> pts;
-    cv::Point c(p.rng().uniform(0, img.cols), p.rng().uniform(0, img.rows));
+    cv::Point c = p.Pixel(img.cols, img.rows);
     for (int k = 0; k < 6; ++k) {
       pts.push_back(c);
-      c += cv::Point(p.Px(p.U(-0.15, 0.15)), p.Px(p.U(-0.1, 0.1)));
+      const int dy = p.Px(p.U(-0.1, 0.1));
+      c += cv::Point(p.Px(p.U(-0.15, 0.15)), dy);
     }
     cv::polylines(img, pts, false, inks[i % 4], std::max(1, p.Px(0.005)),
                   cv::LINE_AA);
@@ -377,8 +389,9 @@ void PaintBoxFace(TexturedPlane* plane, bool metal, cv::RNG* rng) {
     img.setTo(cv::Scalar(70, 130, 175) + p.Colour(-15, 15));
     p.AddNoise({0, 0, img.cols, img.rows}, 7.0, 0.1, 1.0 / p.ppm());
     p.Fill(p.RectM(w * 0.42, 0, w * 0.16, h), cv::Scalar(110, 170, 200));
-    const cv::Rect label = p.RectM(w * p.U(0.05, 0.3), h * p.U(0.1, 0.4),
-                                   w * 0.35, h * 0.35);
+    const double label_t = h * p.U(0.1, 0.4);
+    const cv::Rect label =
+        p.RectM(w * p.U(0.05, 0.3), label_t, w * 0.35, h * 0.35);
     p.Fill(label, cv::Scalar(245, 245, 245));
     p.Text(label, 0.025, cv::Scalar(15, 15, 15), 3);
     // Barcode.
@@ -395,7 +408,8 @@ void PaintBoxFace(TexturedPlane* plane, bool metal, cv::RNG* rng) {
     }
     const int arrows = 2;
     for (int i = 0; i < arrows; ++i) {
-      const cv::Point a(p.Px(w * p.U(0.1, 0.9)), p.Px(h * p.U(0.5, 0.9)));
+      const int ay = p.Px(h * p.U(0.5, 0.9));
+      const cv::Point a(p.Px(w * p.U(0.1, 0.9)), ay);
       cv::arrowedLine(img, a, a - cv::Point(0, p.Px(0.08)),
                       cv::Scalar(20, 20, 20), std::max(1, p.Px(0.008)));
     }

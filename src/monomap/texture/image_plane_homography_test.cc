@@ -8,6 +8,7 @@
 #include "monomap/geometry/homography.h"
 #include "monomap/sim/test_scene.h"
 #include "monomap/util/error.h"
+#include "monomap/util/random.h"
 
 namespace monomap {
 namespace {
@@ -89,7 +90,9 @@ TEST(ImagePlaneHomographyTest, MatchesAnalyticProjectionForExactPoses) {
     const Rigid3d cam_from_world = scene.world_from_cam[h.frame].Inverse();
     double max_err = 0.0;
     for (int i = 0; i < 100; ++i) {
-      const Eigen::Vector2d st(0.6 * u(rng), 0.4 * u(rng));
+      const Eigen::Vector2d st =
+          Eigen::Vector2d(0.6, 0.4).cwiseProduct(
+              DrawLastFirst<Eigen::Vector2d>(u, rng));
       const Eigen::Vector3d x =
           cam_from_world * scene.segments[0].frame.ToWorld(st);
       const Eigen::Vector2d expected = (k * x).hnormalized();

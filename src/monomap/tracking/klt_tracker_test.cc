@@ -29,10 +29,12 @@ cv::Mat MakeTexture(int width, int height, uint64_t seed) {
   cv::Mat img = (noise - mean[0]) * (35.0 / stddev[0]) + 128.0;
   const int shapes = width * height / 2500;
   for (int i = 0; i < shapes; ++i) {
-    const cv::Point c(rng.uniform(0, width), rng.uniform(0, height));
+    const int y = rng.uniform(0, height);  // y first: util/random.h
+    const cv::Point c(rng.uniform(0, width), y);
     const double grey = rng.uniform(30.0, 225.0);
     if (rng.uniform(0, 2) == 0) {
-      const cv::Point d(rng.uniform(4, 30), rng.uniform(4, 30));
+      const int dy = rng.uniform(4, 30);
+      const cv::Point d(rng.uniform(4, 30), dy);
       cv::rectangle(img, c - d, c + d, cv::Scalar(grey), cv::FILLED);
     } else {
       cv::circle(img, c, rng.uniform(3, 20), cv::Scalar(grey), cv::FILLED);

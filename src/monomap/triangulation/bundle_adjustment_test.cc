@@ -12,6 +12,7 @@
 #include "monomap/util/angles.h"
 #include "monomap/util/error.h"
 #include "monomap/util/stats.h"
+#include "monomap/util/random.h"
 
 namespace monomap {
 namespace {
@@ -149,7 +150,7 @@ TEST(BundleAdjustmentTest, SpanPriorsLetTheImagesRemoveOdometryJitter) {
   std::mt19937_64 rng(5);
   std::normal_distribution<double> jitter(0.0, DegToRad(0.05));
   for (size_t i = 1; i < odometry.size(); ++i) {
-    const Eigen::Vector3d w(jitter(rng), jitter(rng), jitter(rng));
+    const auto w = DrawLastFirst<Eigen::Vector3d>(jitter, rng);
     odometry[i] = odometry[i] * Rigid3d(QuaternionFromRotationVector(w),
                                         Eigen::Vector3d::Zero());
   }

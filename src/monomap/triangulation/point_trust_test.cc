@@ -8,6 +8,7 @@
 #include "monomap/sim/test_scene.h"
 #include "monomap/triangulation/triangulator.h"
 #include "monomap/util/error.h"
+#include "monomap/util/random.h"
 
 namespace monomap {
 namespace {
@@ -53,7 +54,7 @@ std::vector<Landmark> LandmarksWithPlantedBadPoints() {
     for (int f = frame; f < frame + 8; ++f) {
       t.observations.push_back(
           {f, scene.camera.ImageFromCam(scene.world_from_cam[f].Inverse() * x) +
-                  Eigen::Vector2d(noise(rng), noise(rng))});
+                  DrawLastFirst<Eigen::Vector2d>(noise, rng)});
     }
     tracks.push_back(t);
   }

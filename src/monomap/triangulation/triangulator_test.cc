@@ -10,6 +10,7 @@
 #include "monomap/sim/test_scene.h"
 #include "monomap/util/error.h"
 #include "monomap/util/stats.h"
+#include "monomap/util/random.h"
 
 namespace monomap {
 namespace {
@@ -77,7 +78,7 @@ TEST(TriangulatorTest, NoisyTracksWithOutliersAndDegenerateCases) {
     for (int f = frame; f < frame + 3; ++f) {
       const Eigen::Vector2d px =
           camera.ImageFromCam(scene.world_from_cam[f].Inverse() * x) +
-          Eigen::Vector2d(noise(rng), noise(rng));
+          DrawLastFirst<Eigen::Vector2d>(noise, rng);
       t.observations.push_back({f, px});
     }
     tracks.push_back(t);
