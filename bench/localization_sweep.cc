@@ -334,8 +334,9 @@ nlohmann::json RunSeed(const SweepOptions& o, const std::string& world,
     lo.mcl.use_kld = !o.fixed_count;
     lo.seed = static_cast<uint64_t>(seed);
     if (o.sigma > 0) lo.mcl.measurement.sigma = o.sigma;
-    if (o.refine_width == 0) lo.mcc.refine_estimate = false;
-    if (o.refine_width > 0) lo.mcc.refinement.width = o.refine_width;
+    if (o.refine_width >= 0) {
+      SetEstimateRefinementWidth(o.refine_width, "--refine-width", &lo.mcc);
+    }
     const double converged_px = configs[c].refine_converged_px >= 0
                                     ? configs[c].refine_converged_px
                                     : o.refine_converged_px;

@@ -59,6 +59,8 @@ struct ReplayArgs {
   // MccOptions::converged_px of the estimate's refinement (0: off, the
   // default): the opt-in early stop, to measure its latency.
   double refine_converged_px = 0.0;
+  // The estimate's refinement (SetEstimateRefinementWidth; -1: default).
+  int refine_width = -1;
 };
 
 double ProcessCpuSeconds() {
@@ -105,6 +107,10 @@ SessionOptions MakeOptions(const ReplayArgs& a) {
   o.max_pending_frames = a.max_pending;
   o.output_particles = false;
   o.localizer.mcc.refinement.converged_px = a.refine_converged_px;
+  if (a.refine_width >= 0) {
+    SetEstimateRefinementWidth(a.refine_width, "--refine-width",
+                               &o.localizer.mcc);
+  }
   return o;
 }
 
@@ -242,6 +248,7 @@ int Run(const ReplayArgs& a) {
   j["init"] = a.init;
   j["threads"] = a.threads;
   j["refine_converged_px"] = a.refine_converged_px;
+  j["refine_width"] = a.refine_width;
   std::printf("%s\n", j.dump(2).c_str());
   if (!a.out.empty()) WriteFileAtomic(a.out, j.dump(2) + "\n");
   return 0;
@@ -273,6 +280,9 @@ int main(int argc, char** argv) {
   app.add_option("--refine-converged-px", a.refine_converged_px,
                  "Stop the estimate's refinement after a round moving less "
                  "than this (px; 0: off)")
+      ->capture_default_str();
+  app.add_option("--refine-width", a.refine_width,
+                 "The estimate's refinement width (0: off; -1: default)")
       ->capture_default_str();
   return monomap::ParseAndRunSweep(app, argc, argv, "realtime_replay",
                                    [&] { return monomap::Run(a); });

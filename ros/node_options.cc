@@ -74,16 +74,9 @@ void ReadLocalizerOptions(const ros::NodeHandle& pnh, LocalizerOptions* o) {
   ReadSize(pnh, "mcc_size", &o->mcc.corrector.width, &o->mcc.corrector.height);
   ReadSize(pnh, "measure_size", &o->mcl.measurement.width,
            &o->mcl.measurement.height);
-  int refine_width = -1;  // the camera's width (up to 1024)
+  int refine_width = EstimateRefinementWidth(o->mcc);
   pnh.param("refine_width", refine_width, refine_width);
-  if (refine_width == 0) {
-    o->mcc.refine_estimate = false;
-  } else if (refine_width > 0) {
-    if (refine_width < 16) {
-      throw OptionsError("~refine_width: must be 0 or at least 16");
-    }
-    o->mcc.refinement.width = refine_width;
-  }
+  SetEstimateRefinementWidth(refine_width, "~refine_width", &o->mcc);
   pnh.param("refine_converged_px", o->mcc.refinement.converged_px,
             o->mcc.refinement.converged_px);
   int seed = int(o->seed);

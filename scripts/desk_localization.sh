@@ -36,10 +36,13 @@ echo "odometry, frames 151-300: vs ground truth $(medians "$OUT/odometry_151.txt
 
 SPAN="--odometry-rotation-sigma-deg 0.1 --odometry-span 10"
 LENS="--camera $OUT/cal_f1.yaml"
+# The estimate's refinement pays only with the refitted lens (MccCorrection-
+# Options::refine_estimate), so the refitted configurations turn it on.
+REFINE="--refine-width 1024"
 configs=(
   "defaults||"
-  "refitted lens, 320 px|$LENS --max-image-radius 320|$LENS"
-  "refitted lens, 320 px, span priors|$LENS --max-image-radius 320 $SPAN|$LENS"
+  "refitted lens, 320 px, refinement|$LENS --max-image-radius 320|$LENS $REFINE"
+  "refitted lens, 320 px, span priors, refinement|$LENS --max-image-radius 320 $SPAN|$LENS $REFINE"
 )
 for i in "${!configs[@]}"; do
   IFS='|' read -r name build_opts loc_opts <<< "${configs[$i]}"

@@ -54,9 +54,12 @@ void AddFilterOptions(CLI::App* cmd, LocalizeArgs* a) {
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   cmd->add_option("--refine-width", a->refine_width,
-                  "MCC: width of the render the estimate is refined against "
-                  "(default: the camera's, up to 1024; 0: no refinement)")
-      ->check(CLI::Range(0, 100000));
+                  "MCC: refine each estimate once more against a render "
+                  "this wide (the camera's width if smaller; 0: off). Pays "
+                  "with a refitted lens, costs 3-5x the update "
+                  "(docs/benchmarks.md)")
+      ->check(CLI::Range(0, 100000))
+      ->default_str(std::to_string(EstimateRefinementWidth(o.mcc)));
   cmd->add_option("--refine-converged-px", o.mcc.refinement.converged_px,
                   "MCC: stop the estimate's refinement after a round that "
                   "moved its inliers less than this (px; 0: never). 0.5 "
@@ -108,14 +111,9 @@ LocalizerOptions ResolveOptions(const LocalizeArgs& a) {
                    &options.mcl.measurement.width,
                    &options.mcl.measurement.height);
   }
-  if (a.refine_width == 0) {
-    options.mcc.refine_estimate = false;
-  } else if (a.refine_width > 0) {
-    if (a.refine_width < 16) {
-      throw OptionsError("--refine-width: must be 0 or at least 16");
-    }
-    // The height follows the camera's aspect (MccCorrection).
-    options.mcc.refinement.width = a.refine_width;
+  if (a.refine_width >= 0) {
+    SetEstimateRefinementWidth(a.refine_width, "--refine-width",
+                               &options.mcc);
   }
   return options;
 }

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <string>
 
 #include "monomap/util/angles.h"
 #include "monomap/util/error.h"
@@ -38,6 +39,20 @@ void MccCorrectionOptions::Check() const {
   CheckOption(spread_deg >= 0, "mcc_spread_deg", "must be >= 0");
   CheckOption(merge_translation_m >= 0, "merge_translation_m", "must be >= 0");
   CheckOption(merge_rotation_deg >= 0, "merge_rotation_deg", "must be >= 0");
+}
+
+void SetEstimateRefinementWidth(int width, const char* name,
+                                MccCorrectionOptions* options) {
+  if (width != 0 && width < 16) {
+    throw OptionsError(std::string(name) + ": must be 0 or at least 16");
+  }
+  options->refine_estimate = width > 0;
+  // The height follows the camera's aspect (RefinementOptions).
+  if (width > 0) options->refinement.width = width;
+}
+
+int EstimateRefinementWidth(const MccCorrectionOptions& options) {
+  return options.refine_estimate ? options.refinement.width : 0;
 }
 
 MccCorrection::MccCorrection(const Renderer* renderer, const Camera& camera,

@@ -33,9 +33,11 @@ struct MccCorrectionOptions {
   double spread_deg = 10.0;
   // Correct the estimate of each update once more against a render of
   // `refinement`'s (larger) size; only the output changes, not the
-  // particles. The particle corrections run small for speed, and at
-  // 160x120 a pixel is ~0.6 degrees of view.
-  bool refine_estimate = true;
+  // particles. Off: it pays only with a lens accurate to the image's rim
+  // (a refitted one); with a map's shipped lens, and in the simulated
+  // worlds, it was no better or worse, at 3-5 times the update's cost
+  // (docs/design-notes.md, "Localization").
+  bool refine_estimate = false;
   // Options of that refinement: its width is the largest used (the live
   // camera's size is kept if smaller), its height follows the camera's
   // aspect.
@@ -57,6 +59,14 @@ struct MccCorrectionOptions {
 
   void Check() const;
 };
+
+// The refinement as the CLI and the ROS node take it, one number: 0 turns
+// it off, a width (>= 16) turns it on at that width. Throws OptionsError
+// naming `name` for anything else.
+void SetEstimateRefinementWidth(int width, const char* name,
+                                MccCorrectionOptions* options);
+// That number for `options` (0: off).
+int EstimateRefinementWidth(const MccCorrectionOptions& options);
 
 // What the particle corrections of one update did.
 struct MccCorrectionStats {
