@@ -164,7 +164,8 @@ nlohmann::json Summarize(const std::vector<SessionResult>& results,
 // The first update weighs and corrects the whole initial particle set and
 // takes many frame periods; the frames that arrive meanwhile are dropped
 // once. The steady state (frames arriving after the first pose) is reported
-// apart from that start-up: drops and latency.
+// apart from that start-up: drops and latency; and when the last drop was
+// (the next updates still carry the initial set's many particles).
 void AddSteadyState(const std::vector<SessionFrame>& frames, double fps,
                     const std::vector<SessionResult>& results,
                     const SessionCounters& c, nlohmann::json* j) {
@@ -183,11 +184,14 @@ void AddSteadyState(const std::vector<SessionFrame>& frames, double fps,
     if (arrival[r.stamp] > first_done) latency.push_back(r.latency_seconds);
   }
   int steady = 0, steady_dropped = 0;
+  double last_drop = 0.0;  // when the drops ended (s after the first frame)
   for (const auto& [stamp, at] : arrival) {
+    if (!processed.count(stamp)) last_drop = at;
     if (at <= first_done) continue;
     ++steady;
     steady_dropped += processed.count(stamp) ? 0 : 1;
   }
+  (*j)["last_drop_s"] = last_drop;
   (*j)["first_update_ms"] = 1e3 * results[0].stats.seconds;
   (*j)["startup_dropped"] = c.dropped - steady_dropped;
   (*j)["steady_frames"] = steady;
