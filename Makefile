@@ -2,8 +2,8 @@
 #   make demo   install missing Debian packages, build, run the demo
 #   make test   install missing Debian packages, build, run all tests
 #   make test-sanitize   the test suite under ASan+UBSan (build-asan)
-#   make test-sanitize-parsers   the util, camera and io tests under
-#               ASan+UBSan (build-fuzz; what CI runs)
+#   make test-sanitize-units   every module's unit tests (ctest label
+#               "unit") under ASan+UBSan (build-fuzz; what CI runs)
 #   make fuzz   build the libFuzzer targets (build-fuzz), run each for
 #               FUZZ_SECONDS on fuzz/corpus/<target>; non-zero on a finding
 #   make check-functions   no function in src/ over 80 lines without a
@@ -36,7 +36,7 @@ FUZZ_TARGETS = camera_yaml camera_mount dataset feature_table image map ply
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
 .PHONY: deps sanitize-deps configure build test test-sanitize fuzz-configure \
-  test-sanitize-parsers fuzz check-functions demo bench clean
+  test-sanitize-units fuzz check-functions demo bench clean
 
 deps:
 	@missing=$$(for p in $(DEB_PACKAGES); do \
@@ -72,7 +72,7 @@ test-sanitize: sanitize-deps
 	  UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 \
 	  ctest --output-on-failure -j $(JOBS)
 
-# The clang build of `make fuzz` and `make test-sanitize-parsers`
+# The clang build of `make fuzz` and `make test-sanitize-units`
 # (build-fuzz): ASan+UBSan and libFuzzer's coverage instrumentation on
 # everything; tests are configured too, so that one build serves both.
 # Configured every time (cheap): a build-fuzz of an older Makefile had
@@ -82,21 +82,16 @@ fuzz-configure: sanitize-deps
 	  -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMONOMAP_BUILD_FUZZERS=ON \
 	  -DMONOMAP_BUILD_TESTS=ON -DMONOMAP_BUILD_BENCH=OFF >/dev/null
 
-# The unit tests of the parsing modules under ASan+UBSan, in the fuzz
-# build: what CI runs of the sanitizers (`make test-sanitize` builds and
-# runs everything, too long for CI). Each runs in its build folder, as
-# ctest runs it.
-SANITIZE_MODULES = util camera io
-test-sanitize-parsers: fuzz-configure
-	cmake --build $(FUZZ_DIR) -j $(JOBS) --target \
-	  $(addsuffix _test,$(SANITIZE_MODULES))
-	@status=0; for m in $(SANITIZE_MODULES); do \
-	  echo "== $${m}_test (ASan+UBSan)"; \
-	  (cd $(FUZZ_DIR)/src/monomap/$$m && \
-	   ASAN_OPTIONS=halt_on_error=1:detect_leaks=1 \
-	   UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 \
-	   ./$${m}_test --gtest_brief=1) || status=1; \
-	done; exit $$status
+# The unit tests of every module (ctest label "unit": src/monomap/*, but
+# not the whole-pipeline tests) under ASan+UBSan, in the fuzz build: what CI
+# runs of the sanitizers. `make test-sanitize` runs everything, the
+# end-to-end tests too, in its own build: too long for CI.
+test-sanitize-units: fuzz-configure
+	cmake --build $(FUZZ_DIR) -j $(JOBS) --target unit_tests
+	cd $(FUZZ_DIR) && \
+	  ASAN_OPTIONS=halt_on_error=1:detect_leaks=1 \
+	  UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 \
+	  ctest -L unit --output-on-failure -j $(JOBS)
 
 # Each target first runs every file of its checked-in corpus (so a
 # regression of a past finding fails at once), then FUZZ_SECONDS of new

@@ -10,18 +10,33 @@ function(monomap_library)
   target_link_libraries(${target} PUBLIC ${ARG_DEPS})
 endfunction()
 
-# monomap_test(NAME <name> SRCS ... DEPS ...)
+# monomap_test(NAME <name> [PIPELINE] SRCS ... DEPS ...)
 # A GoogleTest executable registered with CTest (tests discovered per case).
+# Label "unit": the tests of one module (src/monomap/<module>), built
+# together by the target unit_tests (what `make test-sanitize-units` runs
+# under ASan+UBSan); "e2e": the rest (tests/, ros/, and module tests marked
+# PIPELINE, which run whole pipelines).
 function(monomap_test)
-  cmake_parse_arguments(ARG "" "NAME" "SRCS;DEPS" ${ARGN})
+  cmake_parse_arguments(ARG "PIPELINE" "NAME" "SRCS;DEPS" ${ARGN})
   if(NOT MONOMAP_BUILD_TESTS)
     return()
   endif()
   add_executable(${ARG_NAME} ${ARG_SRCS})
   target_link_libraries(${ARG_NAME} PRIVATE ${ARG_DEPS} GTest::gtest GTest::gtest_main)
+  string(FIND "${CMAKE_CURRENT_SOURCE_DIR}/" "${PROJECT_SOURCE_DIR}/src/monomap/"
+         in_module)
+  set(label e2e)
+  if(in_module EQUAL 0 AND NOT ARG_PIPELINE)
+    set(label unit)
+    if(NOT TARGET unit_tests)
+      add_custom_target(unit_tests)
+    endif()
+    add_dependencies(unit_tests ${ARG_NAME})
+  endif()
   # Cases of one executable share fixture directories under /tmp, so they
   # never run concurrently (RESOURCE_LOCK); executables run in parallel.
   gtest_discover_tests(${ARG_NAME} DISCOVERY_TIMEOUT 60
                        PROPERTIES ENVIRONMENT "MONOMAP_SOURCE_DIR=${PROJECT_SOURCE_DIR}"
-                                  RESOURCE_LOCK ${ARG_NAME})
+                                  RESOURCE_LOCK ${ARG_NAME}
+                                  LABELS ${label})
 endfunction()
