@@ -42,12 +42,12 @@ struct MccOptions {
   // reaches 20-30 cm, and the inlier fit (rms <= ransac_threshold_px)
   // guards against wrong matches. 20 deg rather than 10 lets MCC recover
   // particles near the truth but well off in heading after a kidnapping
-  // (docs/benchmarks.md, "Kidnapped robot").
+  // (docs/design-notes.md, "Localization").
   double max_translation_m = 0.5;
   double max_rotation_deg = 20.0;
   // Added to the renderer's mip bias for the renders tracked here: half a
   // level blurrier tames aliasing along oblique views, which KLT minds more
-  // than the weights do (docs/benchmarks.md).
+  // than the weights do (docs/design-notes.md, "Localization").
   double extra_mip_bias = 0.5;
   // Render-track-solve rounds; the second one starts from an almost
   // aligned render and removes most of the first round's bias.

@@ -90,7 +90,7 @@ struct PlaneFittingOptions {
   // the ghost test, so that a surface beside a segment (a door leaf
   // recessed in its wall) is a plane of its own. Opt-in with merge_coplanar,
   // whose merging it needs: alone it splits walls; together they were not
-  // better over the whole benchmark set (docs/benchmarks.md).
+  // better over the whole benchmark set (docs/design-notes.md).
   bool local_ghost_test = false;
   // Merge segments of one physical plane (issue 18); opt-in, see
   // local_ghost_test.

@@ -51,7 +51,7 @@ struct BundleAdjustmentOptions {
   // every i; 0: off. The per-step priors model the odometry's error as
   // accumulating increments; for an odometry whose error is per-frame
   // jitter, span priors hold the drift while loosened per-step priors let
-  // the images set the motion (figures: docs/benchmarks.md).
+  // the images set the motion (figures: docs/design-notes.md, "Bundle adjustment and calibration").
   int span_poses = 0;
   // Rotation sigma of a span prior (per axis, degrees). Fixed, not grown
   // with the span's length: set it to the drift expected over a span.
@@ -63,7 +63,7 @@ struct BundleAdjustmentOptions {
   // and points, for a calibration that is off at the image's rim. Off by
   // default: it straightens the trajectory but moves the structure; a
   // calibration refitted on board views (`monomap calibrate`) is the better
-  // fix (figures: docs/benchmarks.md).
+  // fix (figures: docs/design-notes.md).
   bool refine_distortion = false;
   // Lens self-calibration (focal, principal point, k1, k2) under a prior;
   // exclusive with refine_distortion.
@@ -104,7 +104,7 @@ struct BundleAdjustmentOptions {
   // CG stops when its residual falls below this fraction of the right-hand
   // side (Ceres' eta). Ceres' default 0.1 leaves the weakly constrained
   // directions (scale, held by the priors alone) unconverged; 1e-3 reaches
-  // the direct solvers' solution (docs/benchmarks.md).
+  // the direct solvers' solution (docs/design-notes.md).
   double iterative_schur_eta = 1e-3;
   // After adjustment, landmarks whose mean reprojection error (raw px)
   // exceeds this are dropped (same meaning and default as
