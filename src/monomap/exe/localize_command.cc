@@ -61,9 +61,10 @@ void AddFilterOptions(CLI::App* cmd, LocalizeArgs* a) {
       ->check(CLI::Range(0, 100000))
       ->default_str(std::to_string(EstimateRefinementWidth(o.mcc)));
   cmd->add_option("--refine-converged-px", o.mcc.refinement.converged_px,
-                  "MCC: stop the estimate's refinement after a round that "
-                  "moved its inliers less than this (px; 0: never). 0.5 "
-                  "saves about a quarter of an update (docs/benchmarks.md)")
+                  "MCC, with --refine-width: stop the estimate's refinement "
+                  "after a round that moved its inliers less than this (px; "
+                  "0: never). 0.5 saves about a quarter of the refinement "
+                  "(docs/benchmarks.md)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   cmd->add_option("--relocalize-ncc-drop", o.recovery.relocalize_ncc_drop,
