@@ -30,6 +30,7 @@
 #include "monomap/rendering/renderer.h"
 #include "monomap/util/angles.h"
 #include "monomap/util/error.h"
+#include "monomap/util/random.h"
 
 namespace monomap {
 namespace {
@@ -234,13 +235,13 @@ MapScene LoadMapScene(const std::string& dir) {
   scene.renderer = std::make_unique<Renderer>(map);
   scene.camera = map.camera.Pinhole();
   cv::RNG rng(13);
+  auto uniform_shift = [](cv::RNG& r) { return r.uniform(-0.02, 0.02); };
+  auto gaussian = [](cv::RNG& r) { return r.gaussian(1); };
   for (int i = 0; i < kBatch; ++i) {
     const Rigid3d& at =
         map.trajectory[i % map.trajectory.size()].world_from_cam;
-    Vector3d shift, axis;  // last element drawn first (util/random.h)
-    for (int k = 2; k >= 0; --k) shift[k] = rng.uniform(-0.02, 0.02);
-    for (int k = 2; k >= 0; --k) axis[k] = rng.gaussian(1);
-    axis.normalize();
+    const Vector3d shift = DrawLastFirst<Vector3d>(uniform_shift, rng);
+    const Vector3d axis = DrawLastFirst<Vector3d>(gaussian, rng).normalized();
     const double angle = DegToRadMulDiv(rng.uniform(0.0, 2.0));
     scene.poses.emplace_back(
         at.rotation * Eigen::Quaterniond(Eigen::AngleAxisd(angle, axis)),
