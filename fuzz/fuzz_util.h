@@ -12,21 +12,39 @@
 #include <fstream>
 #include <string>
 #include <string_view>
+#include <system_error>
+#include <utility>
 #include <vector>
 
 #include "monomap/util/error.h"
 
 namespace monomap::fuzz {
 
-// A scratch directory unique to this process, created once.
+// A directory removed when the process exits normally: libFuzzer ends a
+// timed or counted run with exit(), which runs static destructors.
+class ScopedScratchDir {
+ public:
+  explicit ScopedScratchDir(std::filesystem::path path) : path_(std::move(path)) {
+    std::filesystem::create_directories(path_);
+  }
+  ~ScopedScratchDir() {
+    std::error_code ignored;
+    std::filesystem::remove_all(path_, ignored);
+  }
+  ScopedScratchDir(const ScopedScratchDir&) = delete;
+  ScopedScratchDir& operator=(const ScopedScratchDir&) = delete;
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  std::filesystem::path path_;
+};
+
+// A scratch directory unique to this process, created once and removed at
+// exit (a crash leaves it, next to the reproducer).
 inline const std::filesystem::path& ScratchDir() {
-  static const std::filesystem::path dir = [] {
-    std::filesystem::path d = std::filesystem::temp_directory_path() /
-                              ("monomap-fuzz-" + std::to_string(getpid()));
-    std::filesystem::create_directories(d);
-    return d;
-  }();
-  return dir;
+  static const ScopedScratchDir dir(std::filesystem::temp_directory_path() /
+                                    ("monomap-fuzz-" + std::to_string(getpid())));
+  return dir.path();
 }
 
 inline void WriteFile(const std::filesystem::path& path, std::string_view data) {
