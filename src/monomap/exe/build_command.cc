@@ -152,6 +152,12 @@ void AddMappingOptions(CLI::App* cmd, BuildArgs* a) {
   cmd->add_option("--keyframe-interval", o.keyframes.interval,
                   "Bundle-adjust every n-th frame (1: all frames)")
       ->capture_default_str();
+  cmd->add_option("--max-keyframe-covisibility", o.keyframes.max_covisibility,
+                  "Thin the keyframes (every m-th) until a point is seen by "
+                  "at most this many on average, so that slow runs adjust "
+                  "in linear time (0: never)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   AddTrackingOptions(cmd, &o.tracking);
   cmd->add_option("--max-image-radius", o.max_observation_radius_px,
                   "Leave observations farther than this from the principal "

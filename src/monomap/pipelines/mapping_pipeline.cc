@@ -311,6 +311,7 @@ nlohmann::json BundleAdjustmentJson(const BundleAdjustmentReport& ba) {
           {"final_median_reprojection_error_px", ba.final_median_error_px},
           {"iterations", ba.iterations},
           {"covisibility", ba.covisibility},
+          {"keyframe_thinning", ba.keyframe_thinning},
           {"distortion", ba.distortion},
           {"linear_solver", ba.linear_solver},
           {"points_dropped", ba.num_dropped},

@@ -134,6 +134,9 @@ struct BundleAdjustmentReport {
   // Mean number of frames seeing a joint point, over its observations
   // (sum k^2 / sum k), and the linear solver it chose.
   double covisibility = 0.0;
+  // Every n-th keyframe was adjusted (BundleAdjustKeyframes' thinning; 1:
+  // all of them).
+  int keyframe_thinning = 1;
   std::string linear_solver;
   std::string termination;  // Ceres termination type, "disabled" if off
   // Distortion (k1, k2, p1, p2, k3) the final poses and points go with: the

@@ -1,5 +1,7 @@
 #include "monomap/triangulation/keyframe_adjustment.h"
 
+#include <algorithm>
+#include <cmath>
 #include <unordered_map>
 #include <utility>
 
@@ -16,6 +18,9 @@ void KeyframeOptions::Check() const {
               "mapping.long_min_keyframe_distance_m", "must be >= 0");
   CheckOption(long_min_angle_deg >= 0.0, "mapping.long_min_keyframe_angle_deg",
               "must be >= 0");
+  CheckOption(max_covisibility == 0.0 || max_covisibility >= 3.0,
+              "mapping.max_keyframe_covisibility",
+              "must be >= 3 (a point counts once seen by 3 keyframes) or 0");
 }
 
 std::vector<int> SelectKeyframes(const std::vector<Rigid3d>& world_from_cam,
@@ -45,6 +50,49 @@ std::vector<int> SelectKeyframes(const std::vector<Rigid3d>& world_from_cam,
     keyframes.push_back(num_frames - 1);
   }
   return keyframes;
+}
+
+double KeyframeCovisibility(const std::vector<Track>& tracks,
+                            const std::vector<int>& keyframes, int num_frames) {
+  std::vector<bool> is_key(num_frames, false);
+  for (int f : keyframes) is_key[f] = true;
+  double sum_k = 0.0, sum_k2 = 0.0;
+  for (const Track& t : tracks) {
+    int k = 0;
+    for (const Observation& o : t.observations) {
+      if (o.frame >= 0 && o.frame < num_frames && is_key[o.frame]) ++k;
+    }
+    if (k < 3) continue;
+    sum_k += k;
+    sum_k2 += static_cast<double>(k) * k;
+  }
+  return sum_k > 0.0 ? sum_k2 / sum_k : 0.0;
+}
+
+std::vector<int> ThinKeyframes(const std::vector<Track>& tracks,
+                               const std::vector<int>& keyframes,
+                               int num_frames, const KeyframeOptions& options,
+                               int* thinning) {
+  options.Check();
+  *thinning = 1;
+  if (options.max_covisibility <= 0.0 || keyframes.size() < 3) return keyframes;
+  std::vector<int> kept = keyframes;
+  // Keeping every m-th keyframe divides each track's count by about m; the
+  // loop takes the next m if rounding left it above the bound.
+  double covisibility = KeyframeCovisibility(tracks, kept, num_frames);
+  while (covisibility > options.max_covisibility && kept.size() > 3) {
+    *thinning = std::max(
+        *thinning + 1,
+        static_cast<int>(std::ceil(*thinning * covisibility /
+                                   options.max_covisibility)));
+    kept.clear();
+    for (size_t k = 0; k < keyframes.size(); k += *thinning) {
+      kept.push_back(keyframes[k]);
+    }
+    if (kept.back() != keyframes.back()) kept.push_back(keyframes.back());
+    covisibility = KeyframeCovisibility(tracks, kept, num_frames);
+  }
+  return kept;
 }
 
 namespace {
@@ -96,15 +144,6 @@ BundleAdjustmentReport BundleAdjustKeyframes(
     const KeyframeOptions& keyframe_options,
     std::vector<Rigid3d>* world_from_cam, std::vector<Landmark>* landmarks) {
   const int num_frames = static_cast<int>(world_from_cam->size());
-  const std::vector<int> keyframes =
-      SelectKeyframes(*world_from_cam, keyframe_options);
-  if (static_cast<int>(keyframes.size()) == num_frames) {
-    return BundleAdjust(camera, tracks, options, world_from_cam, landmarks);
-  }
-  std::vector<int> key_index(num_frames, -1);
-  for (size_t k = 0; k < keyframes.size(); ++k) {
-    key_index[keyframes[k]] = static_cast<int>(k);
-  }
   for (const Track& t : tracks) {
     for (const Observation& o : t.observations) {
       if (o.frame < 0 || o.frame >= num_frames) {
@@ -113,6 +152,17 @@ BundleAdjustmentReport BundleAdjustKeyframes(
                          " which has no pose");
       }
     }
+  }
+  int thinning = 1;
+  const std::vector<int> keyframes =
+      ThinKeyframes(tracks, SelectKeyframes(*world_from_cam, keyframe_options),
+                    num_frames, keyframe_options, &thinning);
+  if (static_cast<int>(keyframes.size()) == num_frames) {
+    return BundleAdjust(camera, tracks, options, world_from_cam, landmarks);
+  }
+  std::vector<int> key_index(num_frames, -1);
+  for (size_t k = 0; k < keyframes.size(); ++k) {
+    key_index[keyframes[k]] = static_cast<int>(k);
   }
   const std::vector<Track> key_tracks = KeyframeTracks(tracks, key_index);
   std::unordered_map<FeatureId, bool> usable;
@@ -125,6 +175,7 @@ BundleAdjustmentReport BundleAdjustKeyframes(
   for (int f : keyframes) key_poses.push_back((*world_from_cam)[f]);
   BundleAdjustmentReport report =
       BundleAdjust(camera, key_tracks, options, &key_poses, &key_landmarks);
+  report.keyframe_thinning = thinning;
   InterpolateCorrections(keyframes, key_poses, world_from_cam);
   *landmarks = std::move(key_landmarks);
   return report;

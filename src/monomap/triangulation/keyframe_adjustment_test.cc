@@ -58,10 +58,71 @@ TEST(KeyframeAdjustmentTest, LongSequencesAreSpacedByTravel) {
   EXPECT_THROW(SelectKeyframes(turning, options), OptionsError);
 }
 
+// A track seen in the given frames.
+Track TrackIn(FeatureId id, const std::vector<int>& frames) {
+  Track t;
+  t.id = id;
+  for (int f : frames) t.observations.push_back({f, Eigen::Vector2d(1, 1)});
+  return t;
+}
+
+TEST(KeyframeAdjustmentTest, CovisibilityCountsKeyframeObservations) {
+  const std::vector<int> keyframes = {0, 3, 6, 9, 12};
+  // Seen by 5, 3 and 2 keyframes (the last too few to count).
+  const std::vector<Track> tracks = {TrackIn(1, {0, 1, 3, 6, 9, 12}),
+                                     TrackIn(2, {2, 3, 6, 9}),
+                                     TrackIn(3, {0, 3, 4})};
+  EXPECT_DOUBLE_EQ(KeyframeCovisibility(tracks, keyframes, 13),
+                   (25.0 + 9.0) / (5.0 + 3.0));
+  EXPECT_DOUBLE_EQ(KeyframeCovisibility({tracks[2]}, keyframes, 13), 0.0);
+}
+
+TEST(KeyframeAdjustmentTest, ThinningKeepsEveryMthKeyframeUpToTheBound) {
+  // 301 frames, every third a keyframe (101); 50 tracks each seen by 61
+  // consecutive keyframes (183 frames): covisibility 61.
+  std::vector<int> keyframes;
+  for (int f = 0; f <= 300; f += 3) keyframes.push_back(f);
+  std::vector<Track> tracks;
+  for (int i = 0; i < 50; ++i) {
+    std::vector<int> frames;
+    for (int f = 0; f < 183; ++f) frames.push_back(3 * (i % 40) + f);
+    tracks.push_back(TrackIn(i, frames));
+  }
+  ASSERT_NEAR(KeyframeCovisibility(tracks, keyframes, 301), 61.0, 0.5);
+  KeyframeOptions options;
+  options.max_covisibility = 40.0;
+  int thinning = 0;
+  const std::vector<int> thin =
+      ThinKeyframes(tracks, keyframes, 301, options, &thinning);
+  EXPECT_EQ(thinning, 2);
+  EXPECT_EQ(thin.front(), 0);
+  EXPECT_EQ(thin[1], 6);
+  EXPECT_EQ(thin.back(), 300);
+  EXPECT_EQ(thin.size(), 51u);
+  EXPECT_LE(KeyframeCovisibility(tracks, thin, 301), 40.0);
+  EXPECT_GT(KeyframeCovisibility(tracks, thin, 301), 25.0);
+  // A tighter bound: every 4th (61 / 4 = 15.3 <= 20 but 61 / 3 > 20).
+  options.max_covisibility = 20.0;
+  ThinKeyframes(tracks, keyframes, 301, options, &thinning);
+  EXPECT_EQ(thinning, 4);
+  // Under the bound, or off: unchanged.
+  options.max_covisibility = 70.0;
+  EXPECT_EQ(ThinKeyframes(tracks, keyframes, 301, options, &thinning),
+            keyframes);
+  EXPECT_EQ(thinning, 1);
+  options.max_covisibility = 0.0;
+  EXPECT_EQ(ThinKeyframes(tracks, keyframes, 301, options, &thinning),
+            keyframes);
+  options.max_covisibility = 2.0;
+  EXPECT_THROW(ThinKeyframes(tracks, keyframes, 301, options, &thinning),
+               OptionsError);
+}
+
 // A slow sequence: 600 frames 2 mm apart, every point seen by 80-200
 // frames. Spacing the keyframes by travel (as on a long sequence) gives
 // poses nearly as good as every third frame, from a problem a sixth the
-// size.
+// size; thinning them to the default covisibility (as on a short slow
+// sequence) less good, but still well below the odometry's error.
 TEST(KeyframeAdjustmentTest, TravelSpacedKeyframesKeepThePoses) {
   testing::TestSceneOptions scene_options;
   scene_options.num_frames = 600;
@@ -85,11 +146,13 @@ TEST(KeyframeAdjustmentTest, TravelSpacedKeyframesKeepThePoses) {
                     TriangulationOptions(), &triangulated);
   ASSERT_GT(triangulated.size(), 700u);
 
-  auto run = [&](int long_min_keyframes, std::vector<Rigid3d>* poses) {
+  auto run = [&](int long_min_keyframes, double max_covisibility,
+                 std::vector<Rigid3d>* poses) {
     *poses = odometry;
     std::vector<Landmark> landmarks = triangulated;
     KeyframeOptions options;
     options.long_sequence_min_keyframes = long_min_keyframes;
+    options.max_covisibility = max_covisibility;
     // The scene's camera wobbles by 3 degrees every 60 frames: not turns.
     options.long_min_angle_deg = 10.0;
     return BundleAdjustKeyframes(scene.camera, scene.tracks,
@@ -115,19 +178,34 @@ TEST(KeyframeAdjustmentTest, TravelSpacedKeyframesKeepThePoses) {
     }
     return 1e3 * sum / poses.size();
   };
-  std::vector<Rigid3d> every_third, spaced;
-  const BundleAdjustmentReport a = run(0, &every_third);
-  const BundleAdjustmentReport b = run(150, &spaced);
+  std::vector<Rigid3d> every_third, spaced, thinned;
+  const BundleAdjustmentReport a = run(0, 0.0, &every_third);
+  const BundleAdjustmentReport b = run(150, 0.0, &spaced);
+  // Neither long nor spaced, but thinned to covisibility 40 (the scene's
+  // 49 is below the default bound; a slow hallway's is 117-176).
+  const BundleAdjustmentReport c = run(0, 40.0, &thinned);
   const double odo_mm = mean_error_mm(odometry);
   const double a_mm = mean_error_mm(every_third);
   const double b_mm = mean_error_mm(spaced);
+  const double c_mm = mean_error_mm(thinned);
   std::printf(
-      "poses %d -> %d, residuals %d -> %d, covisibility %.1f -> %.1f, "
-      "%.2f -> %.2f s; position error odometry %.3f, every third %.3f, "
-      "spaced %.3f mm\n",
-      a.num_poses, b.num_poses, a.num_residuals, b.num_residuals,
-      a.covisibility, b.covisibility, a.seconds, b.seconds, odo_mm, a_mm, b_mm);
+      "poses %d -> %d / %d, residuals %d -> %d / %d, covisibility %.1f -> "
+      "%.1f / %.1f, %.2f -> %.2f / %.2f s; position error odometry %.3f, "
+      "every third %.3f, spaced %.3f, thinned %.3f mm\n",
+      a.num_poses, b.num_poses, c.num_poses, a.num_residuals, b.num_residuals,
+      c.num_residuals, a.covisibility, b.covisibility, c.covisibility,
+      a.seconds, b.seconds, c.seconds, odo_mm, a_mm, b_mm, c_mm);
   EXPECT_EQ(a.num_poses, 201);  // every third frame and the last
+  EXPECT_EQ(a.keyframe_thinning, 1);
+  EXPECT_GT(a.covisibility, 40.0);
+  EXPECT_GE(c.keyframe_thinning, 2);
+  EXPECT_LE(c.covisibility, 40.0);
+  EXPECT_LT(c.num_residuals, a.num_residuals / 2 + 1000);
+  EXPECT_EQ(c.termination, "CONVERGENCE");
+  // Thinned (every 6th frame): 1.28 mm. Thinning further is not better:
+  // every 9th 1.20, 12th 1.34, 21st 1.93 mm.
+  EXPECT_LT(c_mm, odo_mm / 2.0);
+  EXPECT_LT(c_mm, 1.8 * a_mm);
   // 1.2 m at 4 cm (the wave adds to the travel).
   EXPECT_NEAR(b.num_poses, 31, 3);
   EXPECT_LT(b.num_residuals, a.num_residuals / 4);
