@@ -3,7 +3,8 @@
 #   make test   install missing Debian packages, build, run all tests
 #   make test-sanitize   the test suite under ASan+UBSan (build-asan)
 #   make test-sanitize-units   every module's unit tests (ctest label
-#               "unit") under ASan+UBSan (build-fuzz; what CI runs)
+#               "unit") and the bad-input catalogue ("catalogue") under
+#               ASan+UBSan (build-fuzz; what CI runs)
 #   make fuzz   build the libFuzzer targets (build-fuzz), run each for
 #               FUZZ_SECONDS on fuzz/corpus/<target>; non-zero on a finding
 #   make check-functions   no function in src/ over 80 lines without a
@@ -83,15 +84,16 @@ fuzz-configure: sanitize-deps
 	  -DMONOMAP_BUILD_TESTS=ON -DMONOMAP_BUILD_BENCH=OFF >/dev/null
 
 # The unit tests of every module (ctest label "unit": src/monomap/*, but
-# not the whole-pipeline tests) under ASan+UBSan, in the fuzz build: what CI
+# not the whole-pipeline tests) and the bad-input catalogue run against the
+# binary (label "catalogue") under ASan+UBSan, in the fuzz build: what CI
 # runs of the sanitizers. `make test-sanitize` runs everything, the
 # end-to-end tests too, in its own build: too long for CI.
 test-sanitize-units: fuzz-configure
-	cmake --build $(FUZZ_DIR) -j $(JOBS) --target unit_tests
+	cmake --build $(FUZZ_DIR) -j $(JOBS) --target unit_tests catalogue_tests
 	cd $(FUZZ_DIR) && \
 	  ASAN_OPTIONS=halt_on_error=1:detect_leaks=1 \
 	  UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 \
-	  ctest -L unit --output-on-failure -j $(JOBS)
+	  ctest -L 'unit|catalogue' --output-on-failure -j $(JOBS)
 
 # Each target first runs every file of its checked-in corpus (so a
 # regression of a past finding fails at once), then FUZZ_SECONDS of new

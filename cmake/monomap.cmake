@@ -10,14 +10,16 @@ function(monomap_library)
   target_link_libraries(${target} PUBLIC ${ARG_DEPS})
 endfunction()
 
-# monomap_test(NAME <name> [PIPELINE] SRCS ... DEPS ...)
+# monomap_test(NAME <name> [PIPELINE] [CATALOGUE] SRCS ... DEPS ...)
 # A GoogleTest executable registered with CTest (tests discovered per case).
 # Label "unit": the tests of one module (src/monomap/<module>), built
-# together by the target unit_tests (what `make test-sanitize-units` runs
-# under ASan+UBSan); "e2e": the rest (tests/, ros/, and module tests marked
-# PIPELINE, which run whole pipelines).
+# together by the target unit_tests; "e2e": the rest (tests/, ros/, and
+# module tests marked PIPELINE, which run whole pipelines). CATALOGUE:
+# label "catalogue" instead, and the target catalogue_tests: the bad-input
+# catalogue, which `make test-sanitize-units` runs under ASan+UBSan with the
+# unit tests.
 function(monomap_test)
-  cmake_parse_arguments(ARG "PIPELINE" "NAME" "SRCS;DEPS" ${ARGN})
+  cmake_parse_arguments(ARG "PIPELINE;CATALOGUE" "NAME" "SRCS;DEPS" ${ARGN})
   if(NOT MONOMAP_BUILD_TESTS)
     return()
   endif()
@@ -32,6 +34,14 @@ function(monomap_test)
       add_custom_target(unit_tests)
     endif()
     add_dependencies(unit_tests ${ARG_NAME})
+  endif()
+  if(ARG_CATALOGUE)
+    # One label per test: gtest_discover_tests does not pass a list.
+    set(label catalogue)
+    if(NOT TARGET catalogue_tests)
+      add_custom_target(catalogue_tests)
+    endif()
+    add_dependencies(catalogue_tests ${ARG_NAME})
   endif()
   # Cases of one executable share fixture directories under /tmp, so they
   # never run concurrently (RESOURCE_LOCK); executables run in parallel.
