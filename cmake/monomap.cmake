@@ -27,21 +27,19 @@ function(monomap_test)
   target_link_libraries(${ARG_NAME} PRIVATE ${ARG_DEPS} GTest::gtest GTest::gtest_main)
   string(FIND "${CMAKE_CURRENT_SOURCE_DIR}/" "${PROJECT_SOURCE_DIR}/src/monomap/"
          in_module)
+  # One label per test: gtest_discover_tests does not pass a list.
   set(label e2e)
-  if(in_module EQUAL 0 AND NOT ARG_PIPELINE)
-    set(label unit)
-    if(NOT TARGET unit_tests)
-      add_custom_target(unit_tests)
-    endif()
-    add_dependencies(unit_tests ${ARG_NAME})
-  endif()
   if(ARG_CATALOGUE)
-    # One label per test: gtest_discover_tests does not pass a list.
     set(label catalogue)
-    if(NOT TARGET catalogue_tests)
-      add_custom_target(catalogue_tests)
+  elseif(in_module EQUAL 0 AND NOT ARG_PIPELINE)
+    set(label unit)
+  endif()
+  # unit_tests / catalogue_tests build the tests of that label.
+  if(NOT label STREQUAL e2e)
+    if(NOT TARGET ${label}_tests)
+      add_custom_target(${label}_tests)
     endif()
-    add_dependencies(catalogue_tests ${ARG_NAME})
+    add_dependencies(${label}_tests ${ARG_NAME})
   endif()
   # Cases of one executable share fixture directories under /tmp, so they
   # never run concurrently (RESOURCE_LOCK); executables run in parallel.
