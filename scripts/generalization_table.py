@@ -32,6 +32,7 @@ def structure_figures(e):
         "area_recall": e["area"]["area_recall"],
         "large_planes_seen": e["area"]["large_planes_seen"],
         "large_planes_recovered": e["area"]["large_planes_recovered"],
+        "area_precision": e["area"].get("area_precision"),
     }
 
 
@@ -62,6 +63,8 @@ def sim_row(out, case):
         "seen_area_m2": e["area"]["seen_area_m2"],
         "large_planes_seen": e["area"]["large_planes_seen"],
         "large_planes_recovered": e["area"]["large_planes_recovered"],
+        "area_precision": e["area"].get("area_precision"),
+        "map_area_m2": e["area"].get("map_area_m2"),
         "share_above_1cm": e["point_error"]["all_landmarks"].get("share_above_1cm"),
         "after_sim3": sim3,
     }
@@ -94,6 +97,11 @@ def share(fraction):
     return "-" if fraction is None else f"{100 * fraction:.1f} %"
 
 
+def pct(fraction):
+    """A fraction in percent ('-' from an older eval)."""
+    return "-" if fraction is None else f"{100 * fraction:.0f} %"
+
+
 def main():
     out, cases = sys.argv[1], sys.argv[2:]
     sims = [sim_row(out, c) for c in cases]
@@ -101,15 +109,15 @@ def main():
     with open(os.path.join(out, "generalization.json"), "w") as f:
         json.dump({"simulated": sims, "real": reals}, f, indent=1)
     lines = ["| run | h m / pitch deg / fps | build s | map planes | true planes seen / recovered / split"
-             " | precision | area recovered (of m^2 seen) | planes >= 1 m^2 recovered"
-             " | points | median error % of distance (p90) | > 1 cm |",
-             "|---|---|---|---|---|---|---|---|---|---|---|"]
+             " | precision | area recovered (of m^2 seen) | map area on the truth"
+             " | planes >= 1 m^2 recovered | points | median error % of distance (p90) | > 1 cm |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in sims:
         lines.append(
             f"| {r['name'].split('_')[0]} seed {r['seed']} | {r['camera_height_m']:g} / {r['pitch_deg']:g} /"
             f" {r['fps']:g} | {r['build_s']} | {r['fitted_planes']} | {r['observed_true_planes']} /"
             f" {r['recovered_true_planes']} / {r['split_true_planes']} | {r['precision']:.2f} |"
-            f" {100 * r['area_recall']:.0f} % ({r['seen_area_m2']:.0f}) |"
+            f" {100 * r['area_recall']:.0f} % ({r['seen_area_m2']:.0f}) | {pct(r['area_precision'])} |"
             f" {r['large_planes_recovered']} / {r['large_planes_seen']} | {r['points']} | {r['median_error_percent']:.2f} ({r['p90_error_percent']:.2f}) |"
             f" {share(r['share_above_1cm'])} |")
     for r in reals:
@@ -117,7 +125,7 @@ def main():
         ab = find_stat(r["eval_points"], "abs") or {}
         med_mm = ab.get("median", float("nan")) * 1000
         lines.append(
-            f"| {r['name']} | real | {r['build_s']} | - | - | - | - | - | {rel.get('count', '-')} |"
+            f"| {r['name']} | real | {r['build_s']} | - | - | - | - | - | - | {rel.get('count', '-')} |"
             f" {rel.get('median', float('nan')):.2f} ({rel.get('p90', float('nan')):.2f}); {med_mm:.2f} mm |"
             f" {share(r['eval_points'].get('share_above_1cm'))} |")
     aligned = [r for r in sims if r["after_sim3"]]
@@ -126,14 +134,15 @@ def main():
                   " (`eval structure --align sim3-poses`): the map's own geometry, without the"
                   " odometry's scale and frame.", "",
                   "| run | map scale | true planes seen / recovered / split | precision"
-                  " | area recovered | planes >= 1 m^2 recovered | median error % of distance (p90) |",
-                  "|---|---|---|---|---|---|---|"]
+                  " | area recovered | map area on the truth | planes >= 1 m^2 recovered"
+                  " | median error % of distance (p90) |",
+                  "|---|---|---|---|---|---|---|---|"]
         for r in aligned:
             a = r["after_sim3"]
             lines.append(
                 f"| {r['name'].split('_')[0]} seed {r['seed']} | {a['scale']:.4f} |"
                 f" {a['observed_true_planes']} / {a['recovered_true_planes']} / {a['split_true_planes']} |"
-                f" {a['precision']:.2f} | {100 * a['area_recall']:.0f} % |"
+                f" {a['precision']:.2f} | {100 * a['area_recall']:.0f} % | {pct(a['area_precision'])} |"
                 f" {a['large_planes_recovered']} / {a['large_planes_seen']} |"
                 f" {a['median_error_percent']:.2f} ({a['p90_error_percent']:.2f}) |")
     with open(os.path.join(out, "generalization.md"), "w") as f:

@@ -130,6 +130,33 @@ PlaneCoverage CoverPlane(const Map& map, const Map& truth, size_t j,
   return {p.id, seen * cell, recovered * cell};
 }
 
+// Area of map plane `p` (samples of spacing h) and how much of it lies on
+// a true plane of the same orientation, within max_distance_m, inside its
+// polygon.
+void MapPlaneOnTruth(const TexturedPlane& p, const Map& truth,
+                     const Rigid3d& truth_from_map, const AreaCoverageOptions& o,
+                     double* area_m2, double* on_truth_m2) {
+  const double cos_max = std::cos(DegToRad(o.max_angle_deg));
+  const Eigen::Vector3d normal_in_truth = truth_from_map.rotation * p.plane.normal;
+  const std::vector<Eigen::Vector3d> samples = SamplePlane(p, o.sample_spacing_m);
+  int on = 0;
+  for (const Eigen::Vector3d& x_in_map : samples) {
+    const Eigen::Vector3d x = truth_from_map * x_in_map;
+    for (const TexturedPlane& q : truth.planes) {
+      if (std::abs(q.plane.normal.dot(normal_in_truth)) < cos_max) continue;
+      if (std::abs(q.plane.SignedDistance(x)) > o.max_distance_m) continue;
+      if (q.polygon.size() >= 3 && !PointInPolygon(q.polygon, q.frame.ToPlane(x))) {
+        continue;
+      }
+      ++on;
+      break;
+    }
+  }
+  const double cell = o.sample_spacing_m * o.sample_spacing_m;
+  *area_m2 = samples.size() * cell;
+  *on_truth_m2 = on * cell;
+}
+
 }  // namespace
 
 AreaCoverage MeasureAreaCoverage(const Map& map, const Map& truth,
@@ -156,6 +183,15 @@ AreaCoverage MeasureAreaCoverage(const Map& map, const Map& truth,
   }
   if (result.seen_area_m2 > 0) {
     result.area_recall = result.recovered_area_m2 / result.seen_area_m2;
+  }
+  for (const TexturedPlane& p : map.planes) {
+    double area = 0.0, on = 0.0;
+    MapPlaneOnTruth(p, truth, truth_from_map, options, &area, &on);
+    result.map_area_m2 += area;
+    result.map_area_on_truth_m2 += on;
+  }
+  if (result.map_area_m2 > 0) {
+    result.area_precision = result.map_area_on_truth_m2 / result.map_area_m2;
   }
   return result;
 }

@@ -49,6 +49,14 @@ struct AreaCoverage {
   int large_planes_seen = 0;
   int large_planes_recovered = 0;
   std::vector<PlaneCoverage> planes;  // in the truth's order
+  // The other direction: the map's polygons sampled on the same grid, and
+  // how much of that area lies on a true plane (within the same angle and
+  // distance, inside its polygon). Growing polygons over space where there
+  // is no surface lowers area_precision.
+  double map_area_m2 = 0.0;
+  double map_area_on_truth_m2 = 0.0;
+  // map_area_on_truth_m2 / map_area_m2 (0 when the map has no area).
+  double area_precision = 0.0;
 };
 
 // Coverage of `truth`'s planes by `map`'s planes, seen from map.trajectory

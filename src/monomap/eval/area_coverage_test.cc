@@ -93,11 +93,29 @@ TEST(AreaCoverage, RecoveredAreaCountsPlanesOfTheRightOrientationAndOffset) {
   EXPECT_NEAR(c.planes[1].recovered_area_m2, 4.76, 0.1);
   EXPECT_NEAR(c.area_recall, (1.0 + 4.76) / (1.0 + 11.36), 0.015);
   EXPECT_EQ(c.large_planes_recovered, 1);  // the wall has < half recovered
+  // The map's own area: 1 + 6 m^2 on the truth, the tilted 8 m^2 not.
+  EXPECT_NEAR(c.map_area_m2, 15.0, 0.05);
+  EXPECT_NEAR(c.map_area_on_truth_m2, 7.0, 0.05);
+  EXPECT_NEAR(c.area_precision, 7.0 / 15.0, 0.01);
   // 4 cm off is beyond max_distance_m: nothing of the far wall.
   map.planes[1] = Wall(1, 4.04, 0.5, 2.0, -2.0, 2.0);
   const AreaCoverage off =
       MeasureAreaCoverage(map, truth, Rigid3d(), AreaCoverageOptions());
   EXPECT_EQ(off.planes[1].recovered_area_m2, 0.0);
+}
+
+TEST(AreaCoverage, MapAreaBeyondTheTruePolygonIsNotOnTheTruth) {
+  const Map truth = Truth();
+  Map map = CameraOnly();
+  // The panel grown 1 m to the left, where there is no panel: half of its
+  // 2 m^2 is on the truth. It also recovers the panel whole.
+  map.planes.push_back(Wall(0, 2.0, -1.5, 0.5, -0.5, 0.5));
+  const AreaCoverage c =
+      MeasureAreaCoverage(map, truth, Rigid3d(), AreaCoverageOptions());
+  EXPECT_NEAR(c.planes[0].recovered_area_m2, 1.0, 0.02);
+  EXPECT_NEAR(c.map_area_m2, 2.0, 0.02);
+  EXPECT_NEAR(c.map_area_on_truth_m2, 1.0, 0.02);
+  EXPECT_NEAR(c.area_precision, 0.5, 0.01);
 }
 
 TEST(AreaCoverage, OptionsAreChecked) {

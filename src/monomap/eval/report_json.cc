@@ -72,6 +72,9 @@ nlohmann::json ToJson(const StructureAccuracy& a) {
                {"area_recall", c.area_recall},
                {"large_planes_seen", c.large_planes_seen},
                {"large_planes_recovered", c.large_planes_recovered},
+               {"map_area_m2", c.map_area_m2},
+               {"map_area_on_truth_m2", c.map_area_on_truth_m2},
+               {"area_precision", c.area_precision},
                {"planes", area_planes}};
   return j;
 }
@@ -152,9 +155,11 @@ std::string FormatTable(const StructureAccuracy& a) {
   const AreaCoverage& c = a.coverage;
   std::snprintf(buf, sizeof(buf),
                 "area recovered %.1f%% (%.2f of %.2f m^2 seen); large "
-                "planes recovered %d of %d\n",
+                "planes recovered %d of %d; map area on the true structure "
+                "%.1f%% (%.2f of %.2f m^2)\n",
                 100 * c.area_recall, c.recovered_area_m2, c.seen_area_m2,
-                c.large_planes_recovered, c.large_planes_seen);
+                c.large_planes_recovered, c.large_planes_seen,
+                100 * c.area_precision, c.map_area_on_truth_m2, c.map_area_m2);
   out += buf;
   out +=
       Header() + Row("all abs (mm)", a.point_error_all.absolute_m, 1e3) +
