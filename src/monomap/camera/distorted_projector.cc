@@ -1,4 +1,4 @@
-#include "monomap/texture/projection.h"
+#include "monomap/camera/distorted_projector.h"
 
 #include <algorithm>
 

@@ -28,6 +28,7 @@ struct BuildArgs {
   bool no_bundle_adjustment = false;
   bool no_affine = false;
   bool merge_coplanar = false;  // planes.merge_coplanar + local_ghost_test
+  bool no_plane_growth = false;
   bool quiet = false;
   bool drop_odometry_jumps = false;
   DatasetOptions dataset_options;
@@ -149,6 +150,31 @@ void AddMappingOptions(CLI::App* cmd, BuildArgs* a) {
   cmd->add_flag("--merge-coplanar", a->merge_coplanar,
                 "Merge plane segments that are one physical plane, and keep "
                 "surfaces beside a plane (a recessed door) apart");
+  cmd->add_flag("--no-plane-growth", a->no_plane_growth,
+                "Bound each plane by its points only (do not grow it over "
+                "the image regions its plane explains)");
+  cmd->add_option("--plane-growth-plain-run", o.growth.max_plain_run,
+                  "Grown planes extend over plain (untextured) cells at "
+                  "most this many cells from texture evidence")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  cmd->add_option("--plane-growth-reach", o.growth.max_growth_cells,
+                  "Grow a plane at most this many cells (about 12 image "
+                  "pixels each) beyond its points' polygon (0: no growth)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  cmd->add_option("--plane-growth-min-ncc", o.growth.min_ncc,
+                  "A textured cell joins a plane if its views correlate "
+                  "(NCC with the view of most parallax, median) at least "
+                  "this much")
+      ->check(CLI::Range(-0.99, 0.99))
+      ->capture_default_str();
+  cmd->add_option("--plane-growth-occluder-dilation",
+                  o.growth.occluder_dilation_cells,
+                  "Another plane hides a cell from a view within this many "
+                  "cells outside its polygon")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   cmd->add_option("--keyframe-interval", o.keyframes.interval,
                   "Bundle-adjust every n-th frame (1: all frames)")
       ->capture_default_str();
@@ -199,6 +225,7 @@ void RunBuild(const BuildArgs& a) {
   options.tracking.affine_refinement = !a.no_affine;
   options.planes.merge_coplanar = a.merge_coplanar;
   options.planes.local_ghost_test = a.merge_coplanar;
+  options.growth.enabled = !a.no_plane_growth;
   options.show_progress = !a.quiet;
   const MappingResult result = BuildMap(dataset, options);
   WriteMappingResult(a.output, result);

@@ -19,6 +19,7 @@ void MappingOptions::Check() const {
   triangulation.Check();
   bundle_adjustment.Check();
   planes.Check();
+  growth.Check();
   homographies.Check();
   mosaic.Check();
   point_trust.Check();
@@ -193,6 +194,12 @@ void SurfaceStages(const Dataset& dataset, const MappingOptions& options,
   report.planes =
       FitPlanes(options.planes, &landmarks, &result->segments, &centers);
   report.timings.push_back({"planes", timer.ElapsedSeconds()});
+  timer.Restart();
+  auto load_grey = [&](int frame) { return dataset.LoadImage(frame, false); };
+  report.growth = GrowPlanePolygons(options.growth, camera, world_from_cam,
+                                    landmarks, tracks, load_grey,
+                                    &result->segments);
+  report.timings.push_back({"plane_growth", timer.ElapsedSeconds()});
   auto load_image = [&](int frame) { return dataset.LoadImage(frame, true); };
   timer.Restart();
   std::vector<ImagePlaneHomography> homographies;
@@ -336,6 +343,22 @@ nlohmann::json PlanesJson(const PlaneFittingReport& planes) {
   return j;
 }
 
+// Per plane: area before and after growth, and the cells added by texture
+// evidence and as plain bridges.
+nlohmann::json GrowthJson(const PlaneGrowthReport& growth) {
+  nlohmann::json planes = nlohmann::json::array();
+  for (const PlaneGrowthStats& p : growth.planes) {
+    planes.push_back({{"plane_id", p.plane_id},
+                      {"cell_m", p.cell_m},
+                      {"area_before_m2", p.area_before_m2},
+                      {"area_after_m2", p.area_after_m2},
+                      {"cells_textured", p.cells_textured},
+                      {"cells_plain", p.cells_plain},
+                      {"cells_carved", p.cells_carved}});
+  }
+  return {{"views", growth.views}, {"seconds", growth.seconds}, {"planes", planes}};
+}
+
 nlohmann::json MosaicsJson(const MosaicReport& mosaic) {
   nlohmann::json mosaics = nlohmann::json::array();
   for (const auto& m : mosaic.planes) {
@@ -390,6 +413,7 @@ nlohmann::json MappingReport::ToJson() const {
        retriangulation.mean_reprojection_error_px}};
   j["bundle_adjustment"] = BundleAdjustmentJson(bundle_adjustment);
   j["planes"] = PlanesJson(planes);
+  j["plane_growth"] = GrowthJson(growth);
   j["homographies"] = {
       {"count", homographies.num_homographies},
       {"checked", homographies.num_checked},

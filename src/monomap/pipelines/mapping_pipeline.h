@@ -11,6 +11,7 @@
 #include "monomap/io/dataset.h"
 #include "monomap/map/map.h"
 #include "monomap/planes/plane_fitting.h"
+#include "monomap/planes/plane_growth.h"
 #include "monomap/texture/image_plane_homography.h"
 #include "monomap/texture/mosaic.h"
 #include "monomap/tracking/klt_tracker.h"
@@ -30,6 +31,9 @@ struct MappingOptions {
   BundleAdjustmentOptions bundle_adjustment;
   // Stage 3: RANSAC planes.
   PlaneFittingOptions planes;
+  // Stage 3b: plane polygons grown over the image regions their plane
+  // explains.
+  PlaneGrowthOptions growth;
   // Stage 4: image-to-plane homographies.
   HomographyOptions homographies;
   // Stage 5: texture mosaics.
@@ -75,6 +79,7 @@ struct MappingReport {
   // Triangulation against the adjusted poses (strict thresholds).
   TriangulationReport retriangulation;
   PlaneFittingReport planes;
+  PlaneGrowthReport growth;
   HomographyReport homographies;
   MosaicReport mosaic;
   // Points exported and left out (by reason) by the trust filter.

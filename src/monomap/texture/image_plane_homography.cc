@@ -10,7 +10,7 @@
 #include <unordered_set>
 
 #include "monomap/geometry/homography.h"
-#include "monomap/texture/projection.h"
+#include "monomap/camera/distorted_projector.h"
 #include "monomap/util/error.h"
 #include "monomap/util/progress.h"
 #include "monomap/util/stats.h"

@@ -12,7 +12,7 @@
 #include <unordered_map>
 #include <unordered_set>
 
-#include "monomap/texture/projection.h"
+#include "monomap/camera/distorted_projector.h"
 #include "monomap/util/error.h"
 #include "monomap/util/progress.h"
 #include "monomap/util/stats.h"

@@ -1,0 +1,50 @@
+#include "monomap/planes/cell_outline.h"
+
+#include <algorithm>
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+#include <vector>
+
+namespace monomap {
+
+Polygon2d OutlineOfCells(const cv::Mat1b& cells, const Eigen::Vector2d& lo,
+                         double cell, int margin) {
+  // Contours pass through boundary pixel centres; upsampling the cells
+  // puts them 1/8 cell inside the occupied area instead of 1/2.
+  constexpr int kUp = 4;
+  cv::Mat1b mask;
+  cv::resize(cells, mask, {}, kUp, kUp, cv::INTER_NEAREST);
+  std::vector<std::vector<cv::Point>> contours;
+  cv::findContours(mask, contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_SIMPLE);
+  if (contours.empty()) return {};
+  const auto largest = std::max_element(
+      contours.begin(), contours.end(), [](const auto& a, const auto& b) {
+        return std::abs(cv::contourArea(a)) < std::abs(cv::contourArea(b));
+      });
+  std::vector<cv::Point> simple;
+  cv::approxPolyDP(*largest, simple, 0.5 * kUp, true);
+  if (simple.size() < 3) return {};
+  // The contour runs through the centres of the boundary pixels: move each
+  // vertex half a pixel outwards (miter offset) onto the pixel edges.
+  Polygon2d px;
+  for (const auto& q : simple) px.emplace_back(q.x + 0.5, q.y + 0.5);
+  const double orientation = PolygonArea(px) > 0 ? 1.0 : -1.0;
+  const size_t m = px.size();
+  Polygon2d poly;
+  for (size_t i = 0; i < m; ++i) {
+    const Eigen::Vector2d& prev = px[(i + m - 1) % m];
+    const Eigen::Vector2d& next = px[(i + 1) % m];
+    const Eigen::Vector2d d1 = (px[i] - prev).normalized();
+    const Eigen::Vector2d d2 = (next - px[i]).normalized();
+    const Eigen::Vector2d n1 = orientation * Eigen::Vector2d(d1.y(), -d1.x());
+    const Eigen::Vector2d n2 = orientation * Eigen::Vector2d(d2.y(), -d2.x());
+    const double denom = std::max(1.0 + n1.dot(n2), 0.25);  // cap spikes
+    const Eigen::Vector2d q = px[i] + 0.5 * (n1 + n2) / denom;
+    poly.emplace_back(lo.x() + (q.x() / kUp - margin) * cell,
+                      lo.y() + (q.y() / kUp - margin) * cell);
+  }
+  if (PolygonArea(poly) < 0) std::reverse(poly.begin(), poly.end());
+  return poly;
+}
+
+}  // namespace monomap

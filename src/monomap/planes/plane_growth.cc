@@ -1,0 +1,492 @@
+#include "monomap/planes/plane_growth.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numeric>
+#include <opencv2/imgproc.hpp>
+#include <string>
+#include <unordered_map>
+
+#include "monomap/camera/distorted_projector.h"
+#include "monomap/geometry/polygon.h"
+#include "monomap/planes/cell_outline.h"
+#include "monomap/util/angles.h"
+#include "monomap/util/error.h"
+#include "monomap/util/stats.h"
+#include "monomap/util/progress.h"
+
+namespace monomap {
+
+void PlaneGrowthOptions::Check() const {
+  CheckOption(cell_px > 0 && std::isfinite(cell_px), "growth.cell_px",
+              "must be positive");
+  CheckOption(samples_per_side >= 2 && samples_per_side <= 16,
+              "growth.samples_per_side", "must be in [2, 16]");
+  CheckOption(max_growth_cells >= 0, "growth.max_growth_cells",
+              "must be >= 0");
+  CheckOption(max_views >= 2, "growth.max_views", "must be >= 2");
+  CheckOption(min_views >= 2, "growth.min_views", "must be >= 2");
+  CheckOption(min_parallax_deg >= 0 && min_parallax_deg < 90,
+              "growth.min_parallax_deg", "must be in [0, 90)");
+  CheckOption(min_cos_view_angle >= 0 && min_cos_view_angle < 1,
+              "growth.min_cos_view_angle", "must be in [0, 1)");
+  CheckOption(min_texture_std >= 0, "growth.min_texture_std", "must be >= 0");
+  CheckOption(min_ncc > -1 && min_ncc < 1, "growth.min_ncc",
+              "must be in (-1, 1)");
+  CheckOption(max_plain_brightness_diff >= 0,
+              "growth.max_plain_brightness_diff", "must be >= 0");
+  CheckOption(max_plain_run >= 0, "growth.max_plain_run", "must be >= 0");
+  CheckOption(min_carving_landmarks >= 1, "growth.min_carving_landmarks",
+              "must be >= 1");
+  CheckOption(carve_margin_factor >= 0, "growth.carve_margin_factor",
+              "must be >= 0");
+  CheckOption(max_carving_rays >= 1, "growth.max_carving_rays",
+              "must be >= 1");
+  CheckOption(occluder_dilation_cells >= 0, "growth.occluder_dilation_cells",
+              "must be >= 0");
+  CheckOption(close_cells >= 0, "growth.close_cells", "must be >= 0");
+  CheckOption(passes >= 1, "growth.passes", "must be >= 1");
+}
+
+namespace {
+
+// A frame used as a view: its grey image and pose.
+struct View {
+  cv::Mat1b grey;
+  Rigid3d cam_from_world;
+  Eigen::Vector3d centre;
+};
+
+// Whether the ray from c to x meets another segment at least `clearance`
+// (m) before x, inside its polygon widened by `dilation` (m).
+bool Hidden(const std::vector<const PlaneSegment*>& occluders,
+            const Eigen::Vector3d& c, const Eigen::Vector3d& x,
+            double clearance, double dilation) {
+  const Eigen::Vector3d d = x - c;
+  const double dist = d.norm();
+  const double lambda_max = 1.0 - clearance / std::max(dist, 1e-9);
+  for (const PlaneSegment* o : occluders) {
+    const Plane& pl = o->plane;
+    const double denom = pl.normal.dot(d);
+    if (std::abs(denom) < 1e-12) continue;
+    const double lambda = -pl.SignedDistance(c) / denom;
+    if (lambda <= 0.0 || lambda >= lambda_max) continue;
+    const Eigen::Vector2d q = o->frame.ToPlane(c + lambda * d);
+    if (DistanceToPolygon(o->polygon, q) <= dilation) return true;
+  }
+  return false;
+}
+
+float Bilinear(const cv::Mat1b& img, const Eigen::Vector2d& px) {
+  const int x0 = std::min(static_cast<int>(px.x()), img.cols - 2);
+  const int y0 = std::min(static_cast<int>(px.y()), img.rows - 2);
+  const float ax = static_cast<float>(px.x() - x0);
+  const float ay = static_cast<float>(px.y() - y0);
+  const uint8_t* r0 = img.ptr<uint8_t>(y0) + x0;
+  const uint8_t* r1 = img.ptr<uint8_t>(y0 + 1) + x0;
+  const float top = r0[0] + ax * (r0[1] - r0[0]);
+  const float bottom = r1[0] + ax * (r1[1] - r1[0]);
+  return top + ay * (bottom - top);
+}
+
+// The grid of one segment: cell (r, c) covers plane coordinates
+// lo + cell * (c, r) and one cell more.
+struct Grid {
+  Eigen::Vector2d lo = Eigen::Vector2d::Zero();
+  double cell = 0.0;
+  int rows = 0, cols = 0;
+  Eigen::Vector2d Centre(int r, int c) const {
+    return lo + cell * Eigen::Vector2d(c + 0.5, r + 0.5);
+  }
+};
+
+enum class Evidence : uint8_t { kNone, kInconsistent, kTextured, kPlain };
+
+// Photometric evidence of one cell: what the views see of it through the
+// plane.
+class CellJudge {
+ public:
+  CellJudge(const PlaneGrowthOptions& options, const PlaneSegment& segment,
+            const Grid& grid, const std::vector<View>& views,
+            const std::vector<const PlaneSegment*>& occluders,
+            const DistortedProjector& projector)
+      : o_(options),
+        seg_(segment),
+        grid_(grid),
+        views_(views),
+        occluders_(occluders),
+        projector_(projector) {}
+
+  Evidence Judge(int r, int c) const {
+    const int k = o_.samples_per_side;
+    const int n = k * k;
+    std::vector<float> patches;  // n values per seeing view
+    std::vector<Eigen::Vector3d> rays;
+    const Eigen::Vector3d centre = seg_.frame.ToWorld(grid_.Centre(r, c));
+    const Camera& camera = projector_.camera();
+    for (const View& v : views_) {
+      const Eigen::Vector3d ray = centre - v.centre;
+      const double dist = ray.norm();
+      if (std::abs(seg_.plane.normal.dot(ray)) < o_.min_cos_view_angle * dist) {
+        continue;
+      }
+      if (Hidden(occluders_, v.centre, centre, 0.5 * grid_.cell,
+                 o_.occluder_dilation_cells * grid_.cell)) {
+        continue;
+      }
+      const size_t start = patches.size();
+      bool ok = true;
+      for (int i = 0; i < n && ok; ++i) {
+        const Eigen::Vector2d st =
+            grid_.lo + grid_.cell * Eigen::Vector2d(c + (i % k + 0.5) / k,
+                                                    r + (i / k + 0.5) / k);
+        Eigen::Vector2d px;
+        ok = projector_.Project(v.cam_from_world * seg_.frame.ToWorld(st),
+                                &px) &&
+             camera.InImage(px, 1.0);
+        if (ok) patches.push_back(Bilinear(v.grey, px));
+      }
+      if (!ok) {
+        patches.resize(start);
+        continue;
+      }
+      rays.push_back(ray / dist);
+    }
+    const int nv = static_cast<int>(rays.size());
+    if (nv < o_.min_views || MaxAngleDeg(rays) < o_.min_parallax_deg) {
+      return Evidence::kNone;
+    }
+    return Photometric(patches, rays, n);
+  }
+
+ private:
+  static double MaxAngleDeg(const std::vector<Eigen::Vector3d>& rays) {
+    double min_cos = 1.0;
+    for (size_t i = 0; i < rays.size(); ++i) {
+      for (size_t j = i + 1; j < rays.size(); ++j) {
+        min_cos = std::min(min_cos, rays[i].dot(rays[j]));
+      }
+    }
+    return RadToDeg(std::acos(std::clamp(min_cos, -1.0, 1.0)));
+  }
+
+  // Textured: NCC of each view's patch with the patch of the view whose
+  // ray differs most from its own (the most parallax: a surface off the
+  // plane shifts most there). Plain: the views' mean brightness against
+  // their median.
+  Evidence Photometric(const std::vector<float>& patches,
+                       const std::vector<Eigen::Vector3d>& rays,
+                       int n) const {
+    const int nv = static_cast<int>(rays.size());
+    std::vector<double> means(nv), stds(nv);
+    for (int v = 0; v < nv; ++v) {
+      const float* p = patches.data() + static_cast<size_t>(v) * n;
+      const double mean = std::accumulate(p, p + n, 0.0) / n;
+      double var = 0.0;
+      for (int i = 0; i < n; ++i) var += (p[i] - mean) * (p[i] - mean);
+      means[v] = mean;
+      stds[v] = std::sqrt(var / n);
+    }
+    if (Median(stds) < o_.min_texture_std) {
+      const double m = Median(means);
+      const double band = o_.max_plain_brightness_diff * std::max(m, 10.0);
+      for (double mean : means) {
+        if (std::abs(mean - m) > band) return Evidence::kInconsistent;
+      }
+      return Evidence::kPlain;
+    }
+    std::vector<double> ncc(nv);
+    for (int v = 0; v < nv; ++v) {
+      int w = v;
+      for (int u = 0; u < nv; ++u) {
+        if (rays[u].dot(rays[v]) < rays[w].dot(rays[v])) w = u;
+      }
+      const float* p = patches.data() + static_cast<size_t>(v) * n;
+      const float* q = patches.data() + static_cast<size_t>(w) * n;
+      double cov = 0.0;
+      for (int i = 0; i < n; ++i) cov += (p[i] - means[v]) * (q[i] - means[w]);
+      const double denom = stds[v] * stds[w] * n;
+      ncc[v] = denom > 0 ? cov / denom : 0.0;
+    }
+    return Median(ncc) >= o_.min_ncc ? Evidence::kTextured
+                                     : Evidence::kInconsistent;
+  }
+
+  const PlaneGrowthOptions& o_;
+  const PlaneSegment& seg_;
+  const Grid& grid_;
+  const std::vector<View>& views_;
+  const std::vector<const PlaneSegment*>& occluders_;
+  const DistortedProjector& projector_;
+};
+
+// Pixels per metre of the plane at plane point st, median over the views
+// that see it in front: focal length / distance, foreshortened by
+// sqrt(|cos|) (the geometric mean of the two in-plane directions). 0 if
+// no view sees it.
+double MedianResolution(const PlaneSegment& seg, const Eigen::Vector2d& st,
+                        const std::vector<View>& views,
+                        const DistortedProjector& projector) {
+  const Eigen::Vector3d x = seg.frame.ToWorld(st);
+  std::vector<double> ppm;
+  for (const View& v : views) {
+    Eigen::Vector2d px;
+    if (!projector.Project(v.cam_from_world * x, &px) ||
+        !projector.camera().InImage(px)) {
+      continue;
+    }
+    const Eigen::Vector3d ray = x - v.centre;
+    const double dist = ray.norm();
+    const double cos = std::abs(seg.plane.normal.dot(ray)) / dist;
+    ppm.push_back(projector.camera().fx / dist * std::sqrt(cos));
+  }
+  return ppm.empty() ? 0.0 : Median(ppm);
+}
+
+// Per cell: how many landmarks behind the plane were seen through it (the
+// ray from an observing camera to the landmark crosses the plane there).
+cv::Mat1i CarvingCounts(const PlaneGrowthOptions& o, const PlaneSegment& seg,
+                        const Grid& grid,
+                        const std::vector<Rigid3d>& world_from_cam,
+                        const std::vector<Landmark>& landmarks,
+                        const std::unordered_map<FeatureId, const Track*>& tracks) {
+  cv::Mat1i counts = cv::Mat1i::zeros(grid.rows, grid.cols);
+  cv::Mat1i last = cv::Mat1i(grid.rows, grid.cols, -1);
+  const Eigen::Vector3d& n = seg.plane.normal;
+  for (int li = 0; li < static_cast<int>(landmarks.size()); ++li) {
+    const Landmark& l = landmarks[li];
+    const auto it = tracks.find(l.id);
+    if (it == tracks.end() || !l.x_in_world.allFinite()) continue;
+    const double var = n.dot(l.covariance_m2_per_px2 * n);
+    const double band = std::max(o.carve_margin_factor * grid.cell,
+                                 std::isfinite(var) && var > 0 ? 3 * std::sqrt(var) : 0.0);
+    const double s_l = seg.plane.SignedDistance(l.x_in_world);
+    if (std::abs(s_l) <= band) continue;
+    const auto& obs = it->second->observations;
+    const int m = static_cast<int>(obs.size());
+    const int rays = std::min(m, o.max_carving_rays);
+    for (int k = 0; k < rays; ++k) {
+      const int f = obs[rays > 1 ? k * (m - 1) / (rays - 1) : 0].frame;
+      if (f < 0 || f >= static_cast<int>(world_from_cam.size())) continue;
+      const Eigen::Vector3d& c = world_from_cam[f].translation;
+      const double s_c = seg.plane.SignedDistance(c);
+      if (s_c * s_l >= 0) continue;  // on the camera's side: not behind
+      const Eigen::Vector3d hit = c + s_c / (s_c - s_l) * (l.x_in_world - c);
+      const Eigen::Vector2d q = (seg.frame.ToPlane(hit) - grid.lo) / grid.cell;
+      const int col = static_cast<int>(std::floor(q.x()));
+      const int row = static_cast<int>(std::floor(q.y()));
+      if (row < 0 || col < 0 || row >= grid.rows || col >= grid.cols) continue;
+      if (last(row, col) == li) continue;  // count landmarks, not rays
+      last(row, col) = li;
+      ++counts(row, col);
+    }
+  }
+  return counts;
+}
+
+// The grid over the polygon's bounds plus the growth reach, and the cells
+// whose centres lie inside the polygon. False if it would be too big.
+bool MakeGrid(const PlaneSegment& seg, double cell, int reach, Grid* grid,
+              cv::Mat1b* inside) {
+  Eigen::Vector2d lo, hi;
+  PolygonBounds(seg.polygon, &lo, &hi);
+  grid->cell = cell;
+  grid->lo = lo - (reach + 1) * cell * Eigen::Vector2d::Ones();
+  const Eigen::Vector2d size = (hi - grid->lo) / cell;
+  const double cols = std::ceil(size.x()) + reach + 1;
+  const double rows = std::ceil(size.y()) + reach + 1;
+  if (cols * rows > 4e6) return false;
+  grid->cols = static_cast<int>(cols);
+  grid->rows = static_cast<int>(rows);
+  *inside = cv::Mat1b::zeros(grid->rows, grid->cols);
+  for (int r = 0; r < grid->rows; ++r) {
+    for (int c = 0; c < grid->cols; ++c) {
+      if (PointInPolygon(seg.polygon, grid->Centre(r, c))) (*inside)(r, c) = 1;
+    }
+  }
+  return true;
+}
+
+// Breadth-first growth from the inside cells, a ring of neighbours at a
+// time (judged in parallel). run(r, c): cells since the last texture
+// evidence; plain cells join only while it stays within max_plain_run.
+cv::Mat1b Grow(const PlaneGrowthOptions& o, const Grid& grid,
+               const cv::Mat1b& inside, const cv::Mat1i& carved,
+               const CellJudge& judge, PlaneGrowthStats* stats) {
+  cv::Mat1b member = inside.clone();
+  cv::Mat1i run(grid.rows, grid.cols, 0);
+  cv::Mat1b tried = inside.clone();
+  static const int kDr[4] = {-1, 1, 0, 0}, kDc[4] = {0, 0, -1, 1};
+  std::vector<cv::Point> frontier;
+  for (int r = 0; r < grid.rows; ++r) {
+    for (int c = 0; c < grid.cols; ++c) {
+      if (member(r, c)) frontier.emplace_back(c, r);
+    }
+  }
+  for (int ring = 0; ring < o.max_growth_cells && !frontier.empty(); ++ring) {
+    std::vector<cv::Point> candidates;
+    for (const cv::Point& p : frontier) {
+      for (int k = 0; k < 4; ++k) {
+        const int r = p.y + kDr[k], c = p.x + kDc[k];
+        if (r < 0 || c < 0 || r >= grid.rows || c >= grid.cols || tried(r, c)) continue;
+        tried(r, c) = 1;
+        candidates.emplace_back(c, r);
+      }
+    }
+    std::vector<Evidence> evidence(candidates.size(), Evidence::kNone);
+    tbb::parallel_for(size_t{0}, candidates.size(), [&](size_t i) {
+      const cv::Point& p = candidates[i];
+      if (carved(p.y, p.x) < o.min_carving_landmarks) {
+        evidence[i] = judge.Judge(p.y, p.x);
+      }
+    });
+    frontier.clear();
+    for (size_t i = 0; i < candidates.size(); ++i) {
+      const cv::Point& p = candidates[i];
+      int best_run = o.max_plain_run + 1;  // through the member neighbours
+      for (int k = 0; k < 4; ++k) {
+        const int r = p.y + kDr[k], c = p.x + kDc[k];
+        if (r >= 0 && c >= 0 && r < grid.rows && c < grid.cols && member(r, c)) {
+          best_run = std::min(best_run, run(r, c));
+        }
+      }
+      if (evidence[i] == Evidence::kTextured) {
+        run(p.y, p.x) = 0;
+        ++stats->cells_textured;
+      } else if (evidence[i] == Evidence::kPlain && best_run < o.max_plain_run) {
+        run(p.y, p.x) = best_run + 1;
+        ++stats->cells_plain;
+      } else {
+        continue;
+      }
+      member(p.y, p.x) = 1;
+      frontier.push_back(p);
+    }
+  }
+  return member;
+}
+
+// Grows one segment against the others (occluders). Returns the new
+// polygon, or the old one if nothing grew.
+Polygon2d GrowSegment(const PlaneGrowthOptions& o, const PlaneSegment& seg,
+                      const std::vector<const PlaneSegment*>& occluders,
+                      const std::vector<View>& views,
+                      const DistortedProjector& projector,
+                      const std::vector<Rigid3d>& world_from_cam,
+                      const std::vector<Landmark>& landmarks,
+                      const std::unordered_map<FeatureId, const Track*>& tracks,
+                      PlaneGrowthStats* stats) {
+  const double ppm =
+      MedianResolution(seg, PolygonCentroid(seg.polygon), views, projector);
+  if (ppm <= 0) return seg.polygon;
+  Grid grid;
+  cv::Mat1b inside;
+  if (!MakeGrid(seg, o.cell_px / ppm, o.max_growth_cells, &grid, &inside)) {
+    return seg.polygon;
+  }
+  stats->cell_m = grid.cell;
+  const cv::Mat1i carved =
+      CarvingCounts(o, seg, grid, world_from_cam, landmarks, tracks);
+  stats->cells_carved = cv::countNonZero(carved >= o.min_carving_landmarks);
+  const CellJudge judge(o, seg, grid, views, occluders, projector);
+  cv::Mat1b member = Grow(o, grid, inside, carved, judge, stats);
+  if (stats->cells_textured + stats->cells_plain == 0) return seg.polygon;
+  member *= 255;
+  if (o.close_cells > 0) {
+    const int k = 2 * o.close_cells + 1;
+    cv::morphologyEx(member, member, cv::MORPH_CLOSE,
+                     cv::getStructuringElement(cv::MORPH_RECT, {k, k}));
+  }
+  Polygon2d poly = OutlineOfCells(member, grid.lo, grid.cell, 0);
+  return poly.size() >= 3 ? poly : seg.polygon;
+}
+
+std::vector<View> LoadViews(const PlaneGrowthOptions& o, const Camera& camera,
+                            const std::vector<Rigid3d>& world_from_cam,
+                            const GreyImageLoader& load_grey) {
+  const int n = static_cast<int>(world_from_cam.size());
+  const int step = std::max(1, (n + o.max_views - 1) / o.max_views);
+  std::vector<int> frames;
+  for (int f = 0; f < n; f += step) frames.push_back(f);
+  std::vector<View> views(frames.size());
+  tbb::parallel_for(size_t{0}, frames.size(), [&](size_t i) {
+    const int f = frames[i];
+    cv::Mat img = load_grey(f);
+    if (img.empty() || img.cols != camera.width || img.rows != camera.height) {
+      throw InputError("image of frame " + std::to_string(f) +
+                       " is empty or not of the camera's size");
+    }
+    if (img.channels() == 3) cv::cvtColor(img, img, cv::COLOR_BGR2GRAY);
+    if (img.depth() != CV_8U) {
+      throw InputError("image of frame " + std::to_string(f) + " is not 8-bit");
+    }
+    views[i].grey = img;
+    views[i].cam_from_world = world_from_cam[f].Inverse();
+    views[i].centre = world_from_cam[f].translation;
+  });
+  return views;
+}
+
+}  // namespace
+
+PlaneGrowthReport GrowPlanePolygons(
+    const PlaneGrowthOptions& options, const Camera& camera,
+    const std::vector<Rigid3d>& world_from_cam,
+    const std::vector<Landmark>& landmarks, const std::vector<Track>& tracks,
+    const GreyImageLoader& load_grey, std::vector<PlaneSegment>* segments) {
+  options.Check();
+  Timer timer;
+  PlaneGrowthReport report;
+  if (!options.enabled || segments->empty() || world_from_cam.size() < 2) {
+    return report;
+  }
+  const std::vector<View> views =
+      LoadViews(options, camera, world_from_cam, load_grey);
+  report.views = static_cast<int>(views.size());
+  const DistortedProjector projector(camera);
+  std::unordered_map<FeatureId, const Track*> track_by_id;
+  for (const Track& t : tracks) track_by_id[t.id] = &t;
+  // Largest first: its grown polygon then hides what lies behind it.
+  std::vector<int> order(segments->size());
+  std::iota(order.begin(), order.end(), 0);
+  std::vector<double> areas(segments->size());
+  for (size_t i = 0; i < segments->size(); ++i) {
+    areas[i] = std::abs(PolygonArea((*segments)[i].polygon));
+  }
+  std::stable_sort(order.begin(), order.end(),
+                   [&](int a, int b) { return areas[a] > areas[b]; });
+  std::vector<Polygon2d> original(segments->size());
+  for (size_t i = 0; i < segments->size(); ++i) {
+    original[i] = (*segments)[i].polygon;
+  }
+  for (int pass = 0; pass < options.passes; ++pass) {
+    report.planes.clear();
+    for (int i : order) {
+      PlaneSegment& seg = (*segments)[i];
+      PlaneGrowthStats stats;
+      stats.plane_id = seg.id;
+      stats.area_before_m2 = areas[i];
+      stats.area_after_m2 = areas[i];
+      if (original[i].size() >= 3) {
+        seg.polygon = original[i];  // regrown against the others' growth
+        std::vector<const PlaneSegment*> occluders;
+        for (const PlaneSegment& other : *segments) {
+          if (&other != &seg && other.polygon.size() >= 3) {
+            occluders.push_back(&other);
+          }
+        }
+        seg.polygon = GrowSegment(options, seg, occluders, views, projector,
+                                  world_from_cam, landmarks, track_by_id, &stats);
+        stats.area_after_m2 = std::abs(PolygonArea(seg.polygon));
+      }
+      report.planes.push_back(stats);
+    }
+  }
+  report.seconds = timer.ElapsedSeconds();
+  return report;
+}
+
+}  // namespace monomap

@@ -1,0 +1,119 @@
+// Growing plane polygons over the image regions their plane explains
+// (issue 18, item 1). A plane fitted to triangulated points is bounded by
+// its points, but a wall or a floor extends over stretches where tracking
+// found few good points: plain paint, grazing views, short tracks. There
+// the images still say where the plane is: a patch of the plane seen from
+// several views of enough parallax looks the same in all of them only if
+// the surface really lies on the plane there (photo-consistency through
+// the plane-induced homography).
+//
+// Growth works on a grid of cells in each segment's plane, starting from
+// its polygon. A cell joins the segment when it is seen by enough views
+// with enough parallax, not hidden by another plane, and
+//  - textured: its patch correlates across the views (NCC), or
+//  - plain: the views agree on its brightness, and it is at most
+//    max_plain_run cells from a cell with texture evidence (or the
+//    original polygon): plain paint agrees from every view, wherever the
+//    plane is, so only texture proves the plane and plain cells only bridge.
+// Free space bounds it: a cell crossed by the viewing rays of landmarks
+// that lie behind the plane is empty (the views looked through it).
+#pragma once
+
+#include <functional>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "monomap/camera/camera.h"
+#include "monomap/geometry/rigid3.h"
+#include "monomap/map/map.h"
+
+namespace monomap {
+
+struct PlaneGrowthOptions {
+  // Grow polygons at all.
+  bool enabled = true;
+  // Cell side in image pixels at the plane's median view resolution, so the
+  // grid is scale-free (a desk and a hallway get the same image support).
+  double cell_px = 12.0;
+  // Samples per cell side (samples^2 per cell and view): about one per
+  // 1.5 image pixels, so that a surface off the plane shifts the pattern.
+  int samples_per_side = 8;
+  // Growth reaches at most this many cells beyond the polygon's bounds.
+  int max_growth_cells = 40;
+  // Frames used as views, evenly spread over the sequence.
+  int max_views = 40;
+  // A cell needs at least this many views that see all its samples.
+  int min_views = 3;
+  // ... whose rays to the cell's centre span at least this angle (deg):
+  // without parallax every plane hypothesis is photo-consistent.
+  double min_parallax_deg = 4.0;
+  // Views at grazing angles (|cos(ray, normal)| below this) do not count.
+  double min_cos_view_angle = 0.15;
+  // A view's patch is textured if its standard deviation (grey levels) is
+  // at least this; a cell is textured if most of its views are.
+  double min_texture_std = 6.0;
+  // Textured cells: median over the views of the NCC of each view's patch
+  // with that of the view of the most parallax from it must reach this.
+  double min_ncc = 0.8;
+  // Plain cells: every view's mean within this fraction of the median
+  // mean (exposure changes and noise stay within it).
+  double max_plain_brightness_diff = 0.12;
+  // Plain cells may extend at most this many cells from texture evidence.
+  int max_plain_run = 8;
+  // A cell crossed by the viewing rays of at least this many landmarks
+  // behind the plane is free space.
+  int min_carving_landmarks = 2;
+  // A landmark is behind the plane if it lies farther than this beyond it:
+  // max(carve_margin_factor x the plane's cell side, its own 3-sigma
+  // uncertainty along the normal).
+  double carve_margin_factor = 0.5;
+  // Observations per landmark whose rays carve (evenly spread).
+  int max_carving_rays = 5;
+  // Another plane hides a cell from a view if the ray meets it within this
+  // many of its cells outside its polygon: planes that grow too, and their
+  // extensions where they meet, still block the views.
+  double occluder_dilation_cells = 2.0;
+  // Holes and notches up to this many cells are closed in the outline.
+  int close_cells = 1;
+  // Growth passes: each regrows every segment from its fitted polygon,
+  // hidden by the others as the previous pass grew them (a wall below a
+  // floor that had not grown yet).
+  int passes = 2;
+
+  void Check() const;
+};
+
+// One segment's growth.
+struct PlaneGrowthStats {
+  int plane_id = 0;
+  double cell_m = 0.0;  // cell side (m)
+  double area_before_m2 = 0.0;
+  double area_after_m2 = 0.0;
+  int cells_textured = 0;  // added on texture evidence
+  int cells_plain = 0;     // added as plain bridges
+  int cells_carved = 0;    // free space by landmark rays (of the grid)
+};
+
+struct PlaneGrowthReport {
+  std::vector<PlaneGrowthStats> planes;
+  int views = 0;  // frames used as views
+  double seconds = 0.0;
+};
+
+// Loads the raw (distorted) grey image of a frame; called from several
+// threads at once.
+using GreyImageLoader = std::function<cv::Mat(int frame)>;
+
+// Grows every segment's polygon over the cells its plane explains (see the
+// top of this file), the largest segment first: a grown plane then hides
+// what lies behind it from the next. Planes and inliers are unchanged.
+// Throws OptionsError for bad options and InputError for an image that is
+// empty or not of the camera's size.
+PlaneGrowthReport GrowPlanePolygons(
+    const PlaneGrowthOptions& options, const Camera& camera,
+    const std::vector<Rigid3d>& world_from_cam,
+    const std::vector<Landmark>& landmarks, const std::vector<Track>& tracks,
+    const GreyImageLoader& load_grey, std::vector<PlaneSegment>* segments);
+
+}  // namespace monomap
