@@ -48,6 +48,9 @@ void PlaneGrowthOptions::Check() const {
   CheckOption(occluder_dilation_cells >= 0, "growth.occluder_dilation_cells",
               "must be >= 0");
   CheckOption(close_cells >= 0, "growth.close_cells", "must be >= 0");
+  CheckOption(layer_cells >= 0, "growth.layer_cells", "must be >= 0");
+  CheckOption(layer_max_angle_deg >= 0 && layer_max_angle_deg < 90,
+              "growth.layer_max_angle_deg", "must be in [0, 90)");
   CheckOption(passes >= 1, "growth.passes", "must be >= 1");
 }
 
@@ -310,12 +313,36 @@ bool MakeGrid(const PlaneSegment& seg, double cell, int reach, Grid* grid,
   return true;
 }
 
+// Cells that lie over a parallel plane's polygon, within layer_cells of
+// it: that plane's, not this one's to grow into.
+cv::Mat1b ClaimedByOthers(const PlaneGrowthOptions& o, const PlaneSegment& seg,
+                          const Grid& grid,
+                          const std::vector<const PlaneSegment*>& others) {
+  cv::Mat1b claimed = cv::Mat1b::zeros(grid.rows, grid.cols);
+  const double cos_max = std::cos(DegToRad(o.layer_max_angle_deg));
+  const double layer = o.layer_cells * grid.cell;
+  for (const PlaneSegment* b : others) {
+    if (std::abs(b->plane.normal.dot(seg.plane.normal)) < cos_max) continue;
+    for (int r = 0; r < grid.rows; ++r) {
+      for (int c = 0; c < grid.cols; ++c) {
+        const Eigen::Vector3d x = seg.frame.ToWorld(grid.Centre(r, c));
+        if (std::abs(b->plane.SignedDistance(x)) <= layer &&
+            PointInPolygon(b->polygon, b->frame.ToPlane(x))) {
+          claimed(r, c) = 1;
+        }
+      }
+    }
+  }
+  return claimed;
+}
+
 // Breadth-first growth from the inside cells, a ring of neighbours at a
 // time (judged in parallel). run(r, c): cells since the last texture
 // evidence; plain cells join only while it stays within max_plain_run.
 cv::Mat1b Grow(const PlaneGrowthOptions& o, const Grid& grid,
                const cv::Mat1b& inside, const cv::Mat1i& carved,
-               const CellJudge& judge, PlaneGrowthStats* stats) {
+               const cv::Mat1b& claimed, const CellJudge& judge,
+               PlaneGrowthStats* stats) {
   cv::Mat1b member = inside.clone();
   cv::Mat1i run(grid.rows, grid.cols, 0);
   cv::Mat1b tried = inside.clone();
@@ -339,7 +366,7 @@ cv::Mat1b Grow(const PlaneGrowthOptions& o, const Grid& grid,
     std::vector<Evidence> evidence(candidates.size(), Evidence::kNone);
     tbb::parallel_for(size_t{0}, candidates.size(), [&](size_t i) {
       const cv::Point& p = candidates[i];
-      if (carved(p.y, p.x) < o.min_carving_landmarks) {
+      if (carved(p.y, p.x) < o.min_carving_landmarks && !claimed(p.y, p.x)) {
         evidence[i] = judge.Judge(p.y, p.x);
       }
     });
@@ -392,7 +419,8 @@ Polygon2d GrowSegment(const PlaneGrowthOptions& o, const PlaneSegment& seg,
       CarvingCounts(o, seg, grid, world_from_cam, landmarks, tracks);
   stats->cells_carved = cv::countNonZero(carved >= o.min_carving_landmarks);
   const CellJudge judge(o, seg, grid, views, occluders, projector);
-  cv::Mat1b member = Grow(o, grid, inside, carved, judge, stats);
+  const cv::Mat1b claimed = ClaimedByOthers(o, seg, grid, occluders);
+  cv::Mat1b member = Grow(o, grid, inside, carved, claimed, judge, stats);
   if (stats->cells_textured + stats->cells_plain == 0) return seg.polygon;
   member *= 255;
   if (o.close_cells > 0) {

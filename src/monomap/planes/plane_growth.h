@@ -16,7 +16,9 @@
 //    original polygon): plain paint agrees from every view, wherever the
 //    plane is, so only texture proves the plane and plain cells only bridge.
 // Free space bounds it: a cell crossed by the viewing rays of landmarks
-// that lie behind the plane is empty (the views looked through it).
+// that lie behind the plane is empty (the views looked through it). And a
+// cell over a parallel plane's polygon, a few cells from it, is that
+// plane's: photo-consistency cannot tell a keyboard's plane from its desk's.
 #pragma once
 
 #include <functional>
@@ -74,6 +76,13 @@ struct PlaneGrowthOptions {
   // many of its cells outside its polygon: planes that grow too, and their
   // extensions where they meet, still block the views.
   double occluder_dilation_cells = 2.0;
+  // A cell within this many cells of a parallel plane (normals within
+  // layer_max_angle_deg) over that plane's polygon belongs to that plane:
+  // a keyboard does not grow over its desk, nor a wall over a door leaf
+  // recessed in it, whose images it would explain almost as well.
+  double layer_cells = 3.0;
+  // See layer_cells.
+  double layer_max_angle_deg = 10.0;
   // Holes and notches up to this many cells are closed in the outline.
   int close_cells = 1;
   // Growth passes: each regrows every segment from its fitted polygon,
