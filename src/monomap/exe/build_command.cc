@@ -169,6 +169,15 @@ void AddMappingOptions(CLI::App* cmd, BuildArgs* a) {
                   "this much")
       ->check(CLI::Range(-0.99, 0.99))
       ->capture_default_str();
+  cmd->add_option("--plane-growth-min-parallax", o.growth.min_parallax_deg,
+                  "A cell's views must span at least this angle (deg)")
+      ->check(CLI::Range(0.0, 89.0))
+      ->capture_default_str();
+  cmd->add_option("--plane-growth-min-cos", o.growth.min_cos_view_angle,
+                  "Views at grazing angles (|cos| to the plane's normal "
+                  "below this) do not count for a cell")
+      ->check(CLI::Range(0.0, 0.99))
+      ->capture_default_str();
   cmd->add_option("--plane-growth-occluder-dilation",
                   o.growth.occluder_dilation_cells,
                   "Another plane hides a cell from a view within this many "
