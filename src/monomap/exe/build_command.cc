@@ -28,7 +28,7 @@ struct BuildArgs {
   bool no_bundle_adjustment = false;
   bool no_affine = false;
   bool merge_coplanar = false;  // planes.merge_coplanar + local_ghost_test
-  bool no_plane_growth = false;
+  bool grow_planes = false;
   bool quiet = false;
   bool drop_odometry_jumps = false;
   DatasetOptions dataset_options;
@@ -150,9 +150,10 @@ void AddMappingOptions(CLI::App* cmd, BuildArgs* a) {
   cmd->add_flag("--merge-coplanar", a->merge_coplanar,
                 "Merge plane segments that are one physical plane, and keep "
                 "surfaces beside a plane (a recessed door) apart");
-  cmd->add_flag("--no-plane-growth", a->no_plane_growth,
-                "Bound each plane by its points only (do not grow it over "
-                "the image regions its plane explains)");
+  cmd->add_flag("--grow-planes", a->grow_planes,
+                "Grow each plane's polygon over the image regions its plane "
+                "explains (photo-consistent across views), beyond its "
+                "points");
   cmd->add_option("--plane-growth-plain-run", o.growth.max_plain_run,
                   "Grown planes extend over plain (untextured) cells at "
                   "most this many cells from texture evidence")
@@ -234,7 +235,7 @@ void RunBuild(const BuildArgs& a) {
   options.tracking.affine_refinement = !a.no_affine;
   options.planes.merge_coplanar = a.merge_coplanar;
   options.planes.local_ghost_test = a.merge_coplanar;
-  options.growth.enabled = !a.no_plane_growth;
+  options.growth.enabled = a.grow_planes;
   options.show_progress = !a.quiet;
   const MappingResult result = BuildMap(dataset, options);
   WriteMappingResult(a.output, result);

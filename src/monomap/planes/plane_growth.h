@@ -33,8 +33,11 @@
 namespace monomap {
 
 struct PlaneGrowthOptions {
-  // Grow polygons at all.
-  bool enabled = true;
+  // Grow polygons at all. Off by default: over the simulated worlds it
+  // recovers 41 % more of the seen structure, but on the real desk the
+  // grown texture moves MCC localization from 2.03 to 2.44 mm
+  // (docs/design-notes.md, "Planes").
+  bool enabled = false;
   // Cell side in image pixels at the plane's median view resolution, so the
   // grid is scale-free (a desk and a hallway get the same image support).
   double cell_px = 12.0;

@@ -62,6 +62,13 @@ double ShareInside(const Polygon2d& poly, double u0, double u1, double v0,
   return all > 0 ? static_cast<double>(in) / all : 0.0;
 }
 
+// Growth is opt-in (build --grow-planes).
+PlaneGrowthOptions GrowthOn() {
+  PlaneGrowthOptions o;
+  o.enabled = true;
+  return o;
+}
+
 GreyImageLoader Loader(const TestScene& scene) {
   return [&scene](int frame) { return scene.images[frame]; };
 }
@@ -70,7 +77,7 @@ TEST(PlaneGrowth, GrowsOverTheTexturedWallAndStopsAtItsEdges) {
   const TestScene scene = Room();
   std::vector<PlaneSegment> segments = {FrontWallPatch(scene, 0.0)};
   const PlaneGrowthReport report =
-      GrowPlanePolygons(PlaneGrowthOptions(), scene.camera,
+      GrowPlanePolygons(GrowthOn(), scene.camera,
                         scene.world_from_cam, {}, {}, Loader(scene), &segments);
   ASSERT_EQ(report.planes.size(), 1u);
   const PlaneGrowthStats& s = report.planes[0];
@@ -94,7 +101,7 @@ TEST(PlaneGrowth, AWrongPlaneDoesNotGrow) {
   // the surface leaves the plane.)
   std::vector<PlaneSegment> segments = {FrontWallPatch(scene, 0.2)};
   const PlaneGrowthReport report =
-      GrowPlanePolygons(PlaneGrowthOptions(), scene.camera,
+      GrowPlanePolygons(GrowthOn(), scene.camera,
                         scene.world_from_cam, {}, {}, Loader(scene), &segments);
   ASSERT_EQ(report.planes.size(), 1u);
   EXPECT_LT(report.planes[0].cells_textured, 10);
@@ -106,7 +113,7 @@ TEST(PlaneGrowth, PlainCellsOnlyBridgeAndLandmarksBehindCarveFreeSpace) {
   // Flat grey images: every cell is plain and consistent, so growth goes
   // exactly max_plain_run cells beyond the patch in every direction.
   for (cv::Mat& img : scene.images) img.setTo(cv::Scalar::all(128));
-  PlaneGrowthOptions options;
+  PlaneGrowthOptions options = GrowthOn();
   options.max_plain_run = 3;
   std::vector<PlaneSegment> segments = {FrontWallPatch(scene, 0.0)};
   PlaneGrowthReport report =
@@ -144,6 +151,17 @@ TEST(PlaneGrowth, PlainCellsOnlyBridgeAndLandmarksBehindCarveFreeSpace) {
   // The carved cells stop growth on the left, not on the right.
   EXPECT_GT(lo.x(), 1.3 - 1.5 * c);
   EXPECT_NEAR(hi.x(), 1.7 + 3 * c, 1.0 * c);
+}
+
+TEST(PlaneGrowth, OffByDefault) {
+  const TestScene scene = Room();
+  std::vector<PlaneSegment> segments = {FrontWallPatch(scene, 0.0)};
+  const Polygon2d before = segments[0].polygon;
+  const PlaneGrowthReport report =
+      GrowPlanePolygons(PlaneGrowthOptions(), scene.camera,
+                        scene.world_from_cam, {}, {}, Loader(scene), &segments);
+  EXPECT_TRUE(report.planes.empty());
+  EXPECT_EQ(segments[0].polygon, before);
 }
 
 TEST(PlaneGrowth, OptionsAreChecked) {
