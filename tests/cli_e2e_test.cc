@@ -307,6 +307,42 @@ TEST_F(Cli, EvalStructurePrintsTheTableAndWritesJson) {
   EXPECT_NE(j["alignment_scale"].get<double>(), 1.0);
 }
 
+// build --grow-planes: the planes grow beyond their points over what the
+// images explain; the report says by how much, and more of the world's
+// seen structure is recovered while the grown area stays on it.
+TEST_F(Cli, GrowPlanesRecoversMoreOfTheSeenStructure) {
+  const fs::path data = *root_ / "data";
+  double recall[2], precision[2];
+  for (int grow = 0; grow < 2; ++grow) {
+    const fs::path map = *root_ / ("map_grow" + std::to_string(grow));
+    const fs::path report = *root_ / ("grow_report" + std::to_string(grow) + ".json");
+    RunResult r = RunMonomap("build " + data.string() + " -o " + map.string() +
+                             " -q --report " + report.string() +
+                             (grow ? " --grow-planes" : ""));
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    std::ifstream report_in(report);
+    const nlohmann::json growth = nlohmann::json::parse(report_in)["plane_growth"];
+    EXPECT_EQ(growth["planes"].size(), grow ? ReadMap(map).planes.size() : 0u);
+    for (const auto& p : growth["planes"]) {
+      EXPECT_GE(p["area_after_m2"].get<double>(),
+                p["area_before_m2"].get<double>());
+    }
+    const fs::path json = *root_ / ("grow_eval" + std::to_string(grow) + ".json");
+    r = RunMonomap("eval structure " + map.string() + " --structure " +
+                   (data / "structure").string() + " --json " + json.string());
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    std::ifstream eval_in(json);
+    const nlohmann::json area = nlohmann::json::parse(eval_in)["area"];
+    recall[grow] = area["area_recall"].get<double>();
+    precision[grow] = area["area_precision"].get<double>();
+  }
+  std::printf("area recovered %.3f -> %.3f, on the truth %.3f -> %.3f\n",
+              recall[0], recall[1], precision[0], precision[1]);
+  // Measured (40 frames, 320x240): 0.140 -> 0.164, all of it on the truth.
+  EXPECT_GT(recall[1], recall[0] + 0.015);
+  EXPECT_GT(precision[1], 0.95);
+}
+
 TEST_F(Cli, EvalStructureErrorsNameThePath) {
   const fs::path data = *root_ / "data";
   // A missing map or structure directory: exit 1, the path named.
