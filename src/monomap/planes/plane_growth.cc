@@ -3,7 +3,6 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <numeric>
 #include <opencv2/imgproc.hpp>
@@ -396,31 +395,49 @@ cv::Mat1b Grow(const PlaneGrowthOptions& o, const Grid& grid,
   return member;
 }
 
-// Grows one segment against the others (occluders). Returns the new
-// polygon, or the old one if nothing grew.
+// What growing a segment needs that does not change between passes: its
+// grid over the fitted polygon, the cells inside it, the carved cells.
+struct SegmentGrid {
+  bool ok = false;  // false: no view sees the polygon, or the grid is too big
+  Grid grid;
+  cv::Mat1b inside;
+  cv::Mat1i carved;
+};
+
+SegmentGrid PrepareGrid(const PlaneGrowthOptions& o, const PlaneSegment& seg,
+                        const std::vector<View>& views,
+                        const DistortedProjector& projector,
+                        const std::vector<Rigid3d>& world_from_cam,
+                        const std::vector<Landmark>& landmarks,
+                        const std::unordered_map<FeatureId, const Track*>& tracks) {
+  SegmentGrid g;
+  if (seg.polygon.size() < 3) return g;
+  const double ppm =
+      MedianResolution(seg, PolygonCentroid(seg.polygon), views, projector);
+  if (ppm <= 0 ||
+      !MakeGrid(seg, o.cell_px / ppm, o.max_growth_cells, &g.grid, &g.inside)) {
+    return g;
+  }
+  g.carved = CarvingCounts(o, seg, g.grid, world_from_cam, landmarks, tracks);
+  g.ok = true;
+  return g;
+}
+
+// Grows one segment (its fitted polygon) against the others (occluders).
+// Returns the new polygon, or the fitted one if nothing grew.
 Polygon2d GrowSegment(const PlaneGrowthOptions& o, const PlaneSegment& seg,
+                      const SegmentGrid& g,
                       const std::vector<const PlaneSegment*>& occluders,
                       const std::vector<View>& views,
                       const DistortedProjector& projector,
-                      const std::vector<Rigid3d>& world_from_cam,
-                      const std::vector<Landmark>& landmarks,
-                      const std::unordered_map<FeatureId, const Track*>& tracks,
                       PlaneGrowthStats* stats) {
-  const double ppm =
-      MedianResolution(seg, PolygonCentroid(seg.polygon), views, projector);
-  if (ppm <= 0) return seg.polygon;
-  Grid grid;
-  cv::Mat1b inside;
-  if (!MakeGrid(seg, o.cell_px / ppm, o.max_growth_cells, &grid, &inside)) {
-    return seg.polygon;
-  }
+  if (!g.ok) return seg.polygon;
+  const Grid& grid = g.grid;
   stats->cell_m = grid.cell;
-  const cv::Mat1i carved =
-      CarvingCounts(o, seg, grid, world_from_cam, landmarks, tracks);
-  stats->cells_carved = cv::countNonZero(carved >= o.min_carving_landmarks);
+  stats->cells_carved = cv::countNonZero(g.carved >= o.min_carving_landmarks);
   const CellJudge judge(o, seg, grid, views, occluders, projector);
   const cv::Mat1b claimed = ClaimedByOthers(o, seg, grid, occluders);
-  cv::Mat1b member = Grow(o, grid, inside, carved, claimed, judge, stats);
+  cv::Mat1b member = Grow(o, grid, g.inside, g.carved, claimed, judge, stats);
   if (stats->cells_textured + stats->cells_plain == 0) return seg.polygon;
   member *= 255;
   if (o.close_cells > 0) {
@@ -487,8 +504,11 @@ PlaneGrowthReport GrowPlanePolygons(
   std::stable_sort(order.begin(), order.end(),
                    [&](int a, int b) { return areas[a] > areas[b]; });
   std::vector<Polygon2d> original(segments->size());
+  std::vector<SegmentGrid> grids(segments->size());
   for (size_t i = 0; i < segments->size(); ++i) {
     original[i] = (*segments)[i].polygon;
+    grids[i] = PrepareGrid(options, (*segments)[i], views, projector,
+                           world_from_cam, landmarks, track_by_id);
   }
   for (int pass = 0; pass < options.passes; ++pass) {
     report.planes.clear();
@@ -506,8 +526,8 @@ PlaneGrowthReport GrowPlanePolygons(
             occluders.push_back(&other);
           }
         }
-        seg.polygon = GrowSegment(options, seg, occluders, views, projector,
-                                  world_from_cam, landmarks, track_by_id, &stats);
+        seg.polygon = GrowSegment(options, seg, grids[i], occluders, views,
+                                  projector, &stats);
         stats.area_after_m2 = std::abs(PolygonArea(seg.polygon));
       }
       report.planes.push_back(stats);
