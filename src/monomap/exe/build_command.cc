@@ -29,6 +29,7 @@ struct BuildArgs {
   bool no_affine = false;
   bool merge_coplanar = false;  // planes.merge_coplanar + local_ghost_test
   bool grow_planes = false;
+  bool no_direction_snap = false;
   bool quiet = false;
   bool drop_odometry_jumps = false;
   DatasetOptions dataset_options;
@@ -150,6 +151,13 @@ void AddMappingOptions(CLI::App* cmd, BuildArgs* a) {
   cmd->add_flag("--merge-coplanar", a->merge_coplanar,
                 "Merge plane segments that are one physical plane, and keep "
                 "surfaces beside a plane (a recessed door) apart");
+  cmd->add_flag("--no-direction-snap", a->no_direction_snap,
+                "Keep every plane's least-squares normal; by default a plane "
+                "whose points allow it takes the direction of the scene's "
+                "well-measured planes or one at right angles to them");
+  cmd->add_option("--snap-max-angle", o.planes.snap_max_angle_deg,
+                  "Largest angle (deg) a plane's normal is snapped by")
+      ->capture_default_str();
   cmd->add_flag("--grow-planes", a->grow_planes,
                 "Grow each plane's polygon over the image regions its plane "
                 "explains (photo-consistent across views), beyond its "
@@ -236,6 +244,7 @@ void RunBuild(const BuildArgs& a) {
   options.planes.merge_coplanar = a.merge_coplanar;
   options.planes.local_ghost_test = a.merge_coplanar;
   options.growth.enabled = a.grow_planes;
+  options.planes.snap_to_directions = !a.no_direction_snap;
   options.show_progress = !a.quiet;
   const MappingResult result = BuildMap(dataset, options);
   WriteMappingResult(a.output, result);

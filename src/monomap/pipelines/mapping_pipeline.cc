@@ -340,6 +340,16 @@ nlohmann::json PlanesJson(const PlaneFittingReport& planes) {
                            {"angle_deg", m.angle_deg},
                            {"offset_m", m.offset_m}});
   }
+  // Segments whose normal was snapped to a direction of the scene (ids as
+  // fitted).
+  j["directions"] = planes.num_directions;
+  j["snaps"] = nlohmann::json::array();
+  for (const auto& sn : planes.snaps) {
+    j["snaps"].push_back({{"segment_id", sn.segment_id},
+                          {"kind", sn.kind},
+                          {"angle_deg", sn.angle_deg},
+                          {"kept_fraction", sn.kept_fraction}});
+  }
   return j;
 }
 

@@ -10,6 +10,7 @@
 
 #include "monomap/geometry/polygon.h"
 #include "monomap/planes/cell_outline.h"
+#include "monomap/planes/plane_directions.h"
 #include "monomap/util/angles.h"
 #include "monomap/util/error.h"
 #include "monomap/util/progress.h"
@@ -51,6 +52,13 @@ void PlaneFittingOptions::Check() const {
               "planes.covariance_sigmas", "must be finite and >= 0");
   CheckOption(polygon_cell_factor > 0, "planes.polygon_cell_factor",
               "must be > 0");
+  CheckOption(snap_max_angle_deg >= 0 && snap_max_angle_deg < 90,
+              "planes.snap_max_angle_deg", "must be in [0, 90)");
+  CheckOption(snap_min_kept_fraction >= 0 && snap_min_kept_fraction <= 1,
+              "planes.snap_min_kept_fraction", "must be in [0, 1]");
+  CheckOption(direction_max_error_deg >= 0 &&
+                  std::isfinite(direction_max_error_deg),
+              "planes.direction_max_error_deg", "must be finite and >= 0");
   CheckOption(merge_max_angle_deg >= 0 && merge_max_angle_deg < 90,
               "planes.merge_max_angle_deg", "must be in [0, 90)");
   CheckOption(merge_max_offset_m >= 0 && std::isfinite(merge_max_offset_m),
@@ -272,6 +280,7 @@ struct FitState {
   std::vector<char> taken;             // on a segment or set aside
   std::vector<Eigen::Vector3d> pts{};  // x_in_world of `remaining`
   std::vector<double> inv_thr{};       // 1 / threshold of `remaining`
+  std::vector<Eigen::Vector3d> directions{};  // well-determined normals
   size_t min_count = 0;
 };
 
@@ -431,6 +440,43 @@ void AbsorbConsistent(const PlaneSegment& seg, double radius, FitState* s) {
   }
 }
 
+// The plane of a segment's points: least squares, snapped to the scene's
+// directions when enabled and the points allow it. With `learn`, a
+// well-determined normal becomes a direction itself and the snap is
+// reported.
+Plane FitSegmentPlane(const std::vector<Eigen::Vector3d>& cpts,
+                      const std::vector<int>& lms, int id, bool learn,
+                      FitState* s) {
+  const PlaneFittingOptions& o = s->options;
+  if (!o.snap_to_directions) return FitPlaneLeastSquares(cpts);
+  // Each point's sigma along the plane's normal: a third of its uncertainty
+  // band (AbsorbConsistent).
+  const Eigen::Vector3d n = FitPlaneLeastSquares(cpts).normal;
+  const double k = o.covariance_sigmas * o.tracking_noise_px;
+  std::vector<double> sigmas(lms.size());
+  for (size_t i = 0; i < lms.size(); ++i) {
+    sigmas[i] = std::max(s->thresholds[lms[i]],
+                         CovarianceBand(s->lms[lms[i]], n, k)) /
+                std::max(o.covariance_sigmas, 1.0);
+  }
+  DirectionSnapOptions snap_options;
+  snap_options.max_angle_rad = DegToRad(o.snap_max_angle_deg);
+  snap_options.band_sigmas = std::max(o.covariance_sigmas, 1.0);
+  snap_options.min_kept_fraction = o.snap_min_kept_fraction;
+  const DirectionSnap snap =
+      SnapToDirections(cpts, sigmas, s->directions, snap_options);
+  if (!learn) return snap.plane;
+  if (snap.kind != DirectionSnap::Kind::kNone) {
+    s->report->snaps.push_back({id, DirectionSnapKindName(snap.kind),
+                                snap.angle_deg, snap.kept_fraction});
+  }
+  if (snap.kind != DirectionSnap::Kind::kParallel &&
+      NormalStandardErrorRad(cpts) <= DegToRad(o.direction_max_error_deg)) {
+    s->directions.push_back(snap.plane.normal);
+  }
+  return snap.plane;
+}
+
 // Turns one connected region of a hypothesis' inliers into a segment.
 void AddSegment(const std::vector<size_t>& inliers,
                 const std::vector<int>& comp, double radius, FitState* s) {
@@ -438,8 +484,12 @@ void AddSegment(const std::vector<size_t>& inliers,
   seg.id = static_cast<int>(s->segments->size());
   std::vector<Eigen::Vector3d> cpts;
   cpts.reserve(comp.size());
-  for (int c : comp) cpts.push_back(s->pts[inliers[c]]);
-  seg.plane = FitPlaneLeastSquares(cpts);
+  std::vector<int> lms;
+  for (int c : comp) {
+    cpts.push_back(s->pts[inliers[c]]);
+    lms.push_back(s->remaining[inliers[c]]);
+  }
+  seg.plane = FitSegmentPlane(cpts, lms, seg.id, /*learn=*/true, s);
   OrientPlane(s->camera_centers, &seg.plane);
   SetSegmentFrame(cpts, &seg);
   seg.inlier_ids.reserve(comp.size());
@@ -514,15 +564,12 @@ Attempt TryHypothesis(int attempt, FitState* s) {
   return accepted ? Attempt::kAccepted : Attempt::kRejected;
 }
 
-// Positions of a segment's inliers (landmark index by id).
-std::vector<Eigen::Vector3d> InlierPoints(
-    const FitState& s, const std::unordered_map<FeatureId, int>& index,
-    const PlaneSegment& seg) {
-  std::vector<Eigen::Vector3d> out;
+// Landmark indices of a segment's inliers (index by id).
+std::vector<int> InlierLandmarks(
+    const std::unordered_map<FeatureId, int>& index, const PlaneSegment& seg) {
+  std::vector<int> out;
   out.reserve(seg.inlier_ids.size());
-  for (FeatureId id : seg.inlier_ids) {
-    out.push_back(s.lms[index.at(id)].x_in_world);
-  }
+  for (FeatureId id : seg.inlier_ids) out.push_back(index.at(id));
   return out;
 }
 
@@ -553,6 +600,7 @@ double PolygonGap(const PlaneSegment& a, const PlaneSegment& b) {
 // A segment while merging: its inlier positions and its id as fitted.
 struct MergeItem {
   std::vector<Eigen::Vector3d> pts;
+  std::vector<int> lms;  // landmark index of each of pts
   int fitted_id = 0;
 };
 
@@ -583,14 +631,14 @@ std::vector<Eigen::Vector3d> PolygonInWorld(const PlaneSegment& seg) {
 
 // Refits a (plane, frame, in-plane coordinates) to the points of a and b
 // and bounds it by the union of their polygons, bridging `gap`.
-void MergeInto(const FitState& s, const MergeItem& item,
-               const PlaneSegment& b, double gap, PlaneSegment* a) {
+void MergeInto(const MergeItem& item, const PlaneSegment& b, double gap,
+               FitState* s, PlaneSegment* a) {
   const std::vector<std::vector<Eigen::Vector3d>> outlines = {
       PolygonInWorld(*a), PolygonInWorld(b)};
   a->inlier_ids.insert(a->inlier_ids.end(), b.inlier_ids.begin(),
                        b.inlier_ids.end());
-  a->plane = FitPlaneLeastSquares(item.pts);
-  OrientPlane(s.camera_centers, &a->plane);
+  a->plane = FitSegmentPlane(item.pts, item.lms, a->id, /*learn=*/false, s);
+  OrientPlane(s->camera_centers, &a->plane);
   SetSegmentFrame(item.pts, a);
   a->inlier_st.resize(item.pts.size());
   for (size_t k = 0; k < item.pts.size(); ++k) {
@@ -621,7 +669,8 @@ bool MergeOnePair(FitState* s, std::vector<MergeItem>* items) {
       m.merged_id = b.fitted_id;
       s->report->merges.push_back(m);
       a.pts.insert(a.pts.end(), b.pts.begin(), b.pts.end());
-      MergeInto(*s, a, segs[j], gap, &segs[i]);
+      a.lms.insert(a.lms.end(), b.lms.begin(), b.lms.end());
+      MergeInto(a, segs[j], gap, s, &segs[i]);
       segs.erase(segs.begin() + j);
       items->erase(items->begin() + j);
       return true;
@@ -640,7 +689,9 @@ void MergeCoplanar(FitState* s) {
   }
   std::vector<MergeItem> items;
   for (const PlaneSegment& seg : segs) {
-    items.push_back({InlierPoints(*s, index, seg), seg.id});
+    MergeItem item{{}, InlierLandmarks(index, seg), seg.id};
+    for (int lm : item.lms) item.pts.push_back(s->lms[lm].x_in_world);
+    items.push_back(std::move(item));
   }
   while (MergeOnePair(s, &items)) {
   }
@@ -679,6 +730,7 @@ PlaneFittingReport FitPlanes(
     std::erase_if(s.remaining, [&](int i) { return s.taken[i] != 0; });
   }
   if (options.merge_coplanar) MergeCoplanar(&s);
+  report.num_directions = static_cast<int>(s.directions.size());
   report.num_planes = static_cast<int>(segments->size());
   report.num_outliers = 0;
   for (const auto& lm : *landmarks) {

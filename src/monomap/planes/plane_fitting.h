@@ -16,6 +16,7 @@
 #include <Eigen/Core>
 #include <cmath>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "monomap/map/map.h"
@@ -92,6 +93,20 @@ struct PlaneFittingOptions {
   // whose merging it needs: alone it splits walls; together they were not
   // better over the whole benchmark set (docs/design-notes.md).
   bool local_ghost_test = false;
+  // Give a segment the direction of the scene's well-determined planes, or
+  // one at right angles to them, when its points allow it within their
+  // noise (plane_directions.h): walls seen from few points at grazing
+  // angles otherwise come out tilted by degrees.
+  bool snap_to_directions = true;
+  // Largest angle (deg) between a segment's free normal and a direction it
+  // snaps to.
+  double snap_max_angle_deg = 15.0;
+  // A snapped plane must keep this share of the points that the free fit
+  // keeps within their uncertainty band (see absorb_consistent_points).
+  double snap_min_kept_fraction = 0.9;
+  // A segment's normal becomes a direction for the later segments when its
+  // standard error (NormalStandardErrorRad) is at most this (deg).
+  double direction_max_error_deg = 0.5;
   // Merge segments of one physical plane (issue 18); opt-in, see
   // local_ghost_test.
   bool merge_coplanar = false;
@@ -126,6 +141,16 @@ struct PlaneFittingReport {
     double offset_m = 0.0;   // largest of the offsets tested
   };
   std::vector<Merge> merges;
+  // One segment whose normal was snapped to a direction of the scene (id as
+  // fitted, before merging renumbers the segments).
+  struct Snap {
+    int segment_id = 0;
+    std::string kind;        // DirectionSnapKindName
+    double angle_deg = 0.0;  // between its free and its snapped normal
+    double kept_fraction = 1.0;  // DirectionSnap::kept_fraction
+  };
+  std::vector<Snap> snaps;
+  int num_directions = 0;  // well-determined directions found
 };
 
 // Fits planes to `landmarks`, sets each landmark's plane_id to the id of its

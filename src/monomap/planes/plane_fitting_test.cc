@@ -625,3 +625,66 @@ TEST(MergeCoplanar, KeyboardOnADeskStaysApart) {
 }
 
 }  // namespace monomap
+
+namespace monomap {
+namespace {
+
+// A 3 m x 3 m floor of 1500 tight points and a corridor wall y = -1 seen as
+// a low strip: tight points at skirting height, loose ones above that are
+// pulled off the wall together (shared pose error), tilting a free fit.
+std::vector<Landmark> FloorAndBiasedWallStrip(uint64_t seed) {
+  std::vector<Landmark> lms;
+  std::mt19937_64 rng(seed);
+  AddPatch(0.0, 3.0, -1.0, 2.0, 0.0, 1500, 0.001, 0.4, &rng, &lms);
+  std::uniform_real_distribution<double> uni(0.0, 1.0);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  const Eigen::Vector3d ray = Eigen::Vector3d(0.4, -1.0, 0.0).normalized();
+  for (int i = 0; i < 60; ++i) {
+    Landmark lm;
+    lm.id = static_cast<FeatureId>(lms.size());
+    const bool high = i % 2 == 1;
+    const double z = high ? 0.15 + 0.4 * uni(rng) : 0.05 + 0.1 * uni(rng);
+    const double sigma = high ? 0.03 : 0.003;
+    const double bias = high ? -0.06 * (z - 0.15) / 0.4 - 0.01 : 0.0;
+    lm.x_in_world = {0.5 + 2.0 * uni(rng), -1.0 + bias + sigma * gauss(rng), z};
+    lm.mean_depth_m = high ? 4.0 : 0.8;
+    // Loose along the viewing ray; 1 px of tracking noise = sigma.
+    lm.covariance_m2_per_px2 = sigma * sigma * ray * ray.transpose() +
+                               1e-8 * Eigen::Matrix3d::Identity();
+    lms.push_back(lm);
+  }
+  return lms;
+}
+
+}  // namespace
+
+TEST(FitPlanes, WallStripFromFewLoosePointsSnapsUpright) {
+  const std::vector<Eigen::Vector3d> cameras = {{1.0, 0.0, 0.4}};
+  PlaneFittingOptions options;
+  options.snap_to_directions = false;
+  std::vector<Landmark> lms = FloorAndBiasedWallStrip(1);
+  std::vector<PlaneSegment> free;
+  FitPlanes(options, &lms, &free, &cameras);
+  ASSERT_EQ(free.size(), 2u);
+  const double free_tilt =
+      std::asin(std::abs(free[1].plane.normal.z())) * 180 / kPi;
+  EXPECT_GT(free_tilt, 2.0);
+
+  options.snap_to_directions = true;
+  std::vector<PlaneSegment> snapped;
+  const auto report = FitPlanes(options, &lms, &snapped, &cameras);
+  ASSERT_EQ(snapped.size(), 2u);
+  EXPECT_GE(report.num_directions, 1);  // the floor's at least
+  ASSERT_EQ(report.snaps.size(), 1u);
+  EXPECT_EQ(report.snaps[0].segment_id, 1);
+  EXPECT_EQ(report.snaps[0].kind, "perpendicular");
+  EXPECT_NEAR(report.snaps[0].angle_deg, free_tilt, 0.5);
+  EXPECT_LT(std::abs(snapped[1].plane.normal.dot(snapped[0].plane.normal)),
+            1e-9);
+  EXPECT_LT(std::acos(std::abs(snapped[1].plane.normal.y())) * 180 / kPi, 1.0);
+  EXPECT_EQ(snapped[1].inlier_ids.size(), free[1].inlier_ids.size());
+  // The floor, fitted first from tight points, is untouched.
+  EXPECT_LT(PlaneAngle(snapped[0].plane, free[0].plane), 1e-12);
+}
+
+}  // namespace monomap
