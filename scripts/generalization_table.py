@@ -33,7 +33,19 @@ def structure_figures(e):
         "large_planes_seen": e["area"]["large_planes_seen"],
         "large_planes_recovered": e["area"]["large_planes_recovered"],
         "area_precision": e["area"].get("area_precision"),
+        "observable_recall": e["area"].get("observable_recall"),
+        "observable_area_m2": e["area"].get("observable_area_m2"),
+        "large_planes_observable": e["area"].get("large_planes_observable"),
+        "large_planes_observable_recovered": e["area"].get("large_planes_observable_recovered"),
     }
+
+
+def observable(a):
+    """Observable area recovered (of m^2 observable) and its large planes ('-' from an older eval)."""
+    if a.get("observable_recall") is None:
+        return "- | -"
+    return (f"{100 * a['observable_recall']:.0f} % ({a['observable_area_m2']:.0f}) |"
+            f" {a['large_planes_observable_recovered']} / {a['large_planes_observable']}")
 
 
 def sim_row(out, case):
@@ -132,18 +144,20 @@ def main():
     if aligned:
         lines += ["", "After the similarity that best fits the map's trajectory to the truth"
                   " (`eval structure --align sim3-poses`): the map's own geometry, without the"
-                  " odometry's scale and frame.", "",
+                  " odometry's scale and frame. Observable: seen by two views within 80 deg of"
+                  " the normal whose rays part by >= 2 deg (eval/area_coverage.h).", "",
                   "| run | map scale | true planes seen / recovered / split | precision"
                   " | area recovered | map area on the truth | planes >= 1 m^2 recovered"
+                  " | observable area recovered (of m^2) | observable planes >= 1 m^2 recovered"
                   " | median error % of distance (p90) |",
-                  "|---|---|---|---|---|---|---|---|"]
+                  "|---|---|---|---|---|---|---|---|---|---|"]
         for r in aligned:
             a = r["after_sim3"]
             lines.append(
                 f"| {r['name'].split('_')[0]} seed {r['seed']} | {a['scale']:.4f} |"
                 f" {a['observed_true_planes']} / {a['recovered_true_planes']} / {a['split_true_planes']} |"
                 f" {a['precision']:.2f} | {100 * a['area_recall']:.0f} % | {pct(a['area_precision'])} |"
-                f" {a['large_planes_recovered']} / {a['large_planes_seen']} |"
+                f" {a['large_planes_recovered']} / {a['large_planes_seen']} | {observable(a)} |"
                 f" {a['median_error_percent']:.2f} ({a['p90_error_percent']:.2f}) |")
     with open(os.path.join(out, "generalization.md"), "w") as f:
         f.write("\n".join(lines) + "\n")

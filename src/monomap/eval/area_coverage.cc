@@ -22,6 +22,10 @@ void AreaCoverageOptions::Check() const {
               "coverage.max_distance_m", "must be positive");
   CheckOption(large_plane_area_m2 >= 0 && std::isfinite(large_plane_area_m2),
               "coverage.large_plane_area_m2", "must not be negative");
+  CheckOption(max_incidence_deg > 0 && max_incidence_deg <= 90,
+              "coverage.max_incidence_deg", "must be in (0, 90]");
+  CheckOption(min_parallax_deg >= 0 && min_parallax_deg < 180,
+              "coverage.min_parallax_deg", "must be in [0, 180)");
 }
 
 namespace {
@@ -71,17 +75,38 @@ struct View {
   Eigen::Vector3d center_in_truth;
 };
 
-bool Seen(const Camera& camera, const std::vector<View>& views,
-          const std::vector<TexturedPlane>& truth, size_t self,
-          const Eigen::Vector3d& x) {
+// How a sample is seen (see AreaCoverageOptions).
+struct Visibility {
+  bool seen = false;
+  bool observable = false;
+};
+
+Visibility Visible(const Camera& camera, const std::vector<View>& views,
+                   const std::vector<TexturedPlane>& truth, size_t self,
+                   const Eigen::Vector3d& x, const AreaCoverageOptions& o) {
+  const double cos_incidence = std::cos(DegToRad(o.max_incidence_deg));
+  const double cos_parallax = std::cos(DegToRad(o.min_parallax_deg));
+  const Eigen::Vector3d& normal = truth[self].plane.normal;
+  Visibility v;
+  std::vector<Eigen::Vector3d> rays;  // of the views within the incidence
   for (const View& view : views) {
     const Eigen::Vector3d x_in_cam = view.cam_from_truth * x;
     if (x_in_cam.z() <= 1e-3) continue;
     const Eigen::Vector2d xn = x_in_cam.head<2>() / x_in_cam.z();
     if (!camera.InImage(camera.PinholeFromNormalized(xn))) continue;
-    if (!Occluded(truth, self, view.center_in_truth, x)) return true;
+    if (Occluded(truth, self, view.center_in_truth, x)) continue;
+    v.seen = true;
+    const Eigen::Vector3d ray = (x - view.center_in_truth).normalized();
+    if (std::abs(ray.dot(normal)) < cos_incidence) continue;
+    for (const Eigen::Vector3d& r : rays) {
+      if (r.dot(ray) <= cos_parallax) {
+        v.observable = true;
+        return v;
+      }
+    }
+    rays.push_back(ray);
   }
-  return false;
+  return v;
 }
 
 // Whether a fitted plane (map frame) of about the same orientation as the
@@ -120,14 +145,19 @@ PlaneCoverage CoverPlane(const Map& map, const Map& truth, size_t j,
   const std::vector<Eigen::Vector3d> samples = SamplePlane(p, o.sample_spacing_m);
   const Rigid3d map_from_truth = truth_from_map.Inverse();
   const Eigen::Vector3d normal_in_map = map_from_truth.rotation * p.plane.normal;
-  int seen = 0, recovered = 0;
+  int seen = 0, recovered = 0, observable = 0, recovered_observable = 0;
   for (const Eigen::Vector3d& x : samples) {
-    if (!Seen(map.camera, views, truth.planes, j, x)) continue;
+    const Visibility v = Visible(map.camera, views, truth.planes, j, x, o);
+    if (!v.seen) continue;
     ++seen;
-    recovered += Recovered(map, normal_in_map, map_from_truth * x, o) ? 1 : 0;
+    const bool r = Recovered(map, normal_in_map, map_from_truth * x, o);
+    recovered += r ? 1 : 0;
+    observable += v.observable ? 1 : 0;
+    recovered_observable += v.observable && r ? 1 : 0;
   }
   const double cell = o.sample_spacing_m * o.sample_spacing_m;
-  return {p.id, seen * cell, recovered * cell};
+  return {p.id, seen * cell, recovered * cell, observable * cell,
+          recovered_observable * cell};
 }
 
 // Area of map plane `p` (samples of spacing h) and how much of it lies on
@@ -157,6 +187,16 @@ void MapPlaneOnTruth(const TexturedPlane& p, const Map& truth,
   *on_truth_m2 = on * cell;
 }
 
+// A plane with at least large_plane_area_m2 of `area` is large; it is
+// recovered when at least half of that area is.
+void CountLargePlane(double area, double recovered,
+                     const AreaCoverageOptions& o, int* large,
+                     int* large_recovered) {
+  if (area < o.large_plane_area_m2 || area <= 0) return;
+  ++*large;
+  if (recovered >= 0.5 * area) ++*large_recovered;
+}
+
 }  // namespace
 
 AreaCoverage MeasureAreaCoverage(const Map& map, const Map& truth,
@@ -173,16 +213,20 @@ AreaCoverage MeasureAreaCoverage(const Map& map, const Map& truth,
   for (const PlaneCoverage& c : result.planes) {
     result.seen_area_m2 += c.seen_area_m2;
     result.recovered_area_m2 += c.recovered_area_m2;
-    if (c.seen_area_m2 < options.large_plane_area_m2 || c.seen_area_m2 <= 0) {
-      continue;
-    }
-    ++result.large_planes_seen;
-    if (c.recovered_area_m2 >= 0.5 * c.seen_area_m2) {
-      ++result.large_planes_recovered;
-    }
+    result.observable_area_m2 += c.observable_area_m2;
+    result.recovered_observable_area_m2 += c.recovered_observable_area_m2;
+    CountLargePlane(c.seen_area_m2, c.recovered_area_m2, options,
+                    &result.large_planes_seen, &result.large_planes_recovered);
+    CountLargePlane(c.observable_area_m2, c.recovered_observable_area_m2,
+                    options, &result.large_planes_observable,
+                    &result.large_planes_observable_recovered);
   }
   if (result.seen_area_m2 > 0) {
     result.area_recall = result.recovered_area_m2 / result.seen_area_m2;
+  }
+  if (result.observable_area_m2 > 0) {
+    result.observable_recall =
+        result.recovered_observable_area_m2 / result.observable_area_m2;
   }
   for (const TexturedPlane& p : map.planes) {
     double area = 0.0, on = 0.0;

@@ -3,7 +3,11 @@
 // grid; a sample is seen if some camera of the map's trajectory has it in
 // its image, in front and not hidden by another true plane; it is recovered
 // if a fitted plane of the same orientation passes near it and its polygon
-// contains it.
+// contains it. A seen sample is also *observable* if two of those cameras
+// see it within max_incidence_deg of its plane's normal, their rays to it
+// parting by at least min_parallax_deg: what any multi-view method needs to
+// place it. A wall seen once, or only far ahead along the direction of
+// travel, or a floor seen only at a grazing angle is seen, not observable.
 #pragma once
 
 #include <vector>
@@ -27,6 +31,10 @@ struct AreaCoverageOptions {
   // True planes with at least this much seen area (m^2) are "large": the
   // issue asks that 90 % of them be recovered.
   double large_plane_area_m2 = 1.0;
+  // Observable: seen at most this far (deg) from the plane's normal ...
+  double max_incidence_deg = 80.0;
+  // ... by two views whose rays part by at least this much (deg).
+  double min_parallax_deg = 2.0;
 
   // Throws OptionsError on a value that makes no sense.
   void Check() const;
@@ -37,6 +45,8 @@ struct PlaneCoverage {
   int true_id = 0;
   double seen_area_m2 = 0.0;
   double recovered_area_m2 = 0.0;
+  double observable_area_m2 = 0.0;            // part of the seen area
+  double recovered_observable_area_m2 = 0.0;  // part of the recovered area
 };
 
 struct AreaCoverage {
@@ -48,6 +58,12 @@ struct AreaCoverage {
   // them have at least half of their seen area recovered.
   int large_planes_seen = 0;
   int large_planes_recovered = 0;
+  // The same over the observable samples only.
+  double observable_area_m2 = 0.0;
+  double recovered_observable_area_m2 = 0.0;
+  double observable_recall = 0.0;
+  int large_planes_observable = 0;
+  int large_planes_observable_recovered = 0;
   std::vector<PlaneCoverage> planes;  // in the truth's order
   // The other direction: the map's polygons sampled on the same grid, and
   // how much of that area lies on a true plane (within the same angle and

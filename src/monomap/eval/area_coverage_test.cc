@@ -118,9 +118,54 @@ TEST(AreaCoverage, MapAreaBeyondTheTruePolygonIsNotOnTheTruth) {
   EXPECT_NEAR(c.area_precision, 0.5, 0.01);
 }
 
+TEST(AreaCoverage, ObservableAreaNeedsTwoViewsApartAndNotGrazing) {
+  const Map truth = Truth();
+  Map map = CameraOnly();
+  const AreaCoverage one =
+      MeasureAreaCoverage(map, truth, Rigid3d(), AreaCoverageOptions());
+  EXPECT_EQ(one.observable_area_m2, 0.0);  // one view places nothing
+  EXPECT_EQ(one.large_planes_observable, 0);
+  // A second view 2 cm to the side: 0.6 deg of parallax at the panel.
+  map.trajectory.push_back(
+      {1.0, Rigid3d(Eigen::Quaterniond::Identity(), {0.02, 0, 0})});
+  EXPECT_EQ(MeasureAreaCoverage(map, truth, Rigid3d(), AreaCoverageOptions())
+                .observable_area_m2,
+            0.0);
+  // 30 cm to the side: 8.5 deg at the panel, >= 4.3 deg at the wall. The
+  // panel is seen whole by both; of the wall, what both see.
+  map.trajectory[1].world_from_cam.translation = {0.3, 0, 0};
+  map.planes.push_back(Wall(0, 2.0, -0.5, 0.5, -0.5, 0.5));
+  const AreaCoverage two =
+      MeasureAreaCoverage(map, truth, Rigid3d(), AreaCoverageOptions());
+  EXPECT_NEAR(two.planes[0].observable_area_m2, 1.0, 0.02);
+  EXPECT_NEAR(two.planes[0].recovered_observable_area_m2, 1.0, 0.02);
+  EXPECT_GT(two.planes[1].observable_area_m2, 9.0);
+  EXPECT_LE(two.planes[1].observable_area_m2, two.planes[1].seen_area_m2);
+  EXPECT_EQ(two.large_planes_observable, 2);
+  EXPECT_EQ(two.large_planes_observable_recovered, 1);
+  EXPECT_NEAR(two.observable_recall,
+              1.0 / (two.planes[0].observable_area_m2 +
+                     two.planes[1].observable_area_m2),
+              1e-9);
+  // Only views within 3 deg of the normal count: the panel's centre, seen
+  // nearly head-on by the first camera, but at 8.5 deg by the second.
+  AreaCoverageOptions head_on;
+  head_on.max_incidence_deg = 3.0;
+  EXPECT_EQ(MeasureAreaCoverage(map, truth, Rigid3d(), head_on)
+                .planes[0]
+                .observable_area_m2,
+            0.0);
+}
+
 TEST(AreaCoverage, OptionsAreChecked) {
   AreaCoverageOptions o;
   o.sample_spacing_m = 0;
+  EXPECT_THROW(o.Check(), OptionsError);
+  o = AreaCoverageOptions();
+  o.max_incidence_deg = 0;
+  EXPECT_THROW(o.Check(), OptionsError);
+  o = AreaCoverageOptions();
+  o.min_parallax_deg = -1;
   EXPECT_THROW(o.Check(), OptionsError);
   o = AreaCoverageOptions();
   o.max_angle_deg = 95;

@@ -65,7 +65,10 @@ nlohmann::json ToJson(const StructureAccuracy& a) {
   for (const PlaneCoverage& p : c.planes) {
     area_planes.push_back({{"true_id", p.true_id},
                            {"seen_area_m2", p.seen_area_m2},
-                           {"recovered_area_m2", p.recovered_area_m2}});
+                           {"recovered_area_m2", p.recovered_area_m2},
+                           {"observable_area_m2", p.observable_area_m2},
+                           {"recovered_observable_area_m2",
+                            p.recovered_observable_area_m2}});
   }
   j["area"] = {{"seen_area_m2", c.seen_area_m2},
                {"recovered_area_m2", c.recovered_area_m2},
@@ -75,6 +78,12 @@ nlohmann::json ToJson(const StructureAccuracy& a) {
                {"map_area_m2", c.map_area_m2},
                {"map_area_on_truth_m2", c.map_area_on_truth_m2},
                {"area_precision", c.area_precision},
+               {"observable_area_m2", c.observable_area_m2},
+               {"recovered_observable_area_m2", c.recovered_observable_area_m2},
+               {"observable_recall", c.observable_recall},
+               {"large_planes_observable", c.large_planes_observable},
+               {"large_planes_observable_recovered",
+                c.large_planes_observable_recovered},
                {"planes", area_planes}};
   return j;
 }
@@ -160,6 +169,13 @@ std::string FormatTable(const StructureAccuracy& a) {
                 100 * c.area_recall, c.recovered_area_m2, c.seen_area_m2,
                 c.large_planes_recovered, c.large_planes_seen,
                 100 * c.area_precision, c.map_area_on_truth_m2, c.map_area_m2);
+  out += buf;
+  std::snprintf(buf, sizeof(buf),
+                "observable area (2 views, parallax and incidence bounded) "
+                "recovered %.1f%% (%.2f of %.2f m^2); large planes %d of %d\n",
+                100 * c.observable_recall, c.recovered_observable_area_m2,
+                c.observable_area_m2, c.large_planes_observable_recovered,
+                c.large_planes_observable);
   out += buf;
   out +=
       Header() + Row("all abs (mm)", a.point_error_all.absolute_m, 1e3) +
