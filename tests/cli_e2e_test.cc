@@ -259,6 +259,64 @@ TEST_F(Cli, CalibrateAndCameraOverrideErrors) {
   EXPECT_GT(ReadMap(*root_ / "m_cam").landmarks.size(), 50u);
 }
 
+// `eval points --over-board` keeps the points over the YAML's chessboard
+// (issue 18's protocol on the desk), `--align` moves the map into the
+// ground truth's frame first; misused flags are usage errors.
+TEST_F(Cli, EvalPointsOverTheBoardAndAligned) {
+  const fs::path data = *root_ / "data";
+  const fs::path map = *root_ / "map_points";
+  RunResult r =
+      RunMonomap("build " + data.string() + " -o " + map.string() + " -q");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  // A 4 x 3 board of 25 cm squares on the floor z = 0, centred under the
+  // points' median.
+  const Map m = ReadMap(map);
+  std::vector<double> xs, ys;
+  for (const Landmark& l : m.landmarks) {
+    xs.push_back(l.x_in_world.x());
+    ys.push_back(l.x_in_world.y());
+  }
+  std::nth_element(xs.begin(), xs.begin() + xs.size() / 2, xs.end());
+  std::nth_element(ys.begin(), ys.begin() + ys.size() / 2, ys.end());
+  const fs::path yaml = *root_ / "board.yaml";
+  std::ofstream(yaml) << "plane: {normal: [0, 0, 1], offset: 0.0}\n"
+                      << "chessboard: {inner_corners_x: 3, inner_corners_y: 2, "
+                      << "square_m: 0.25, origin: [" << xs[xs.size() / 2] - 0.375
+                      << ", " << ys[ys.size() / 2] - 0.25
+                      << ", 0], x_axis: [1, 0, 0], y_axis: [0, 1, 0]}\n";
+  auto evaluate = [&](const std::string& flags) {
+    const fs::path json = *root_ / "points.json";
+    const RunResult run = RunMonomap("eval points " + map.string() +
+                                     " --plane " + yaml.string() + " " + flags +
+                                     " --json " + json.string());
+    EXPECT_EQ(run.exit_code, 0) << run.output;
+    std::ifstream in(json);
+    const nlohmann::json j = nlohmann::json::parse(in);
+    return j;
+  };
+  const nlohmann::json all = evaluate("");
+  const nlohmann::json board = evaluate("--over-board");
+  const size_t n_all = all.at("absolute_m").at("count").get<size_t>();
+  const size_t n_board = board.at("absolute_m").at("count").get<size_t>();
+  EXPECT_GT(n_board, 10u);
+  EXPECT_LT(n_board, n_all / 2);
+  EXPECT_TRUE(board.at("over_board").get<bool>());
+  const nlohmann::json aligned = evaluate(
+      "--over-board --align sim3-poses --groundtruth " +
+      (data / "groundtruth.txt").string());
+  EXPECT_EQ(aligned.at("alignment").get<std::string>(), "sim3-poses");
+  EXPECT_GT(aligned.at("absolute_m").at("count").get<size_t>(), 10u);
+  // Misuse: --over-board without --plane, --align without --groundtruth.
+  r = RunMonomap("eval points " + map.string() + " --surface " +
+                 yaml.string() + " --over-board");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--over-board needs --plane"), std::string::npos);
+  r = RunMonomap("eval points " + map.string() + " --plane " + yaml.string() +
+                 " --align se3");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--groundtruth"), std::string::npos) << r.output;
+}
+
 TEST_F(Cli, EvalStructurePrintsTheTableAndWritesJson) {
   const fs::path data = *root_ / "data";
   const fs::path map = *root_ / "map_structure";

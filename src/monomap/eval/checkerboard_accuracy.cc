@@ -10,6 +10,14 @@
 #include "monomap/util/file.h"
 
 namespace monomap {
+
+bool CheckerboardSpec::Over(const Eigen::Vector3d& x) const {
+  const Eigen::Vector3d d = x - origin;
+  const double u = d.dot(x_axis.normalized()) / square_m;
+  const double v = d.dot(y_axis.normalized()) / square_m;
+  return u >= -1.0 && u <= inner_corners_x && v >= -1.0 &&
+         v <= inner_corners_y;
+}
 namespace {
 
 // The texture in grey, its unseen texels (alpha 0) shown on white as a

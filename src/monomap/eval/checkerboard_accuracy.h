@@ -25,6 +25,10 @@ struct CheckerboardSpec {
   Eigen::Vector3d Corner(int i, int j) const {
     return origin + square_m * (i * x_axis + j * y_axis);
   }
+  // Whether x lies over the printed board: its inner corners' rectangle
+  // grown by the one square of the outer row on every side (in the board's
+  // plane, any height above or below it).
+  bool Over(const Eigen::Vector3d& x) const;
 };
 
 struct CheckerboardAccuracy {

@@ -122,3 +122,29 @@ TEST(Checkerboard, YamlOfTheWrongKindNamesTheField) {
 
 }  // namespace
 }  // namespace monomap
+
+namespace monomap {
+namespace {
+
+TEST(Checkerboard, OverTheBoardIncludesItsOuterSquaresAtAnyHeight) {
+  CheckerboardSpec board;  // 9 x 6 inner corners, 4 cm squares, at z = 0
+  board.origin = {0.1, 0.2, 0.0};
+  // Inner corners span [0, 8] x [0, 5] squares; the printed board one more.
+  EXPECT_TRUE(board.Over(board.origin));
+  EXPECT_TRUE(board.Over(board.Corner(8, 5)));
+  EXPECT_TRUE(board.Over(board.origin + Eigen::Vector3d(-0.039, -0.039, 0)));
+  EXPECT_TRUE(board.Over(board.Corner(9, 6) - Eigen::Vector3d(1e-6, 1e-6, 0)));
+  EXPECT_FALSE(board.Over(board.origin + Eigen::Vector3d(-0.041, 0, 0)));
+  EXPECT_FALSE(board.Over(board.Corner(4, 6) + Eigen::Vector3d(0, 0.001, 0)));
+  // A mug standing on the board is over it; one beside it is not.
+  EXPECT_TRUE(board.Over(board.Corner(4, 3) + Eigen::Vector3d(0, 0, -0.1)));
+  EXPECT_FALSE(board.Over(board.Corner(12, 3) + Eigen::Vector3d(0, 0, -0.1)));
+  // A rotated board: its own axes count, not the world's.
+  board.x_axis = Eigen::Vector3d(0, 1, 0);
+  board.y_axis = Eigen::Vector3d(-1, 0, 0);
+  EXPECT_TRUE(board.Over(board.Corner(8, 5)));
+  EXPECT_FALSE(board.Over(board.origin + Eigen::Vector3d(0.1, 0, 0)));
+}
+
+}  // namespace
+}  // namespace monomap
