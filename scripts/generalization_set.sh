@@ -4,7 +4,8 @@
 # several seeds, camera heights, pitches and frame rates, builds a map of each
 # and scores it with `eval structure` (over ALL exported points); adds the real
 # desk halves (frames 0-149 and 150-299, built separately; `eval points
-# --plane` over all exported points, and `eval planes`) and castle_visp.
+# --plane` over all exported points and over the board, and `eval planes`)
+# and castle_visp.
 # Writes OUTDIR/generalization.json and OUTDIR/generalization.md.
 #
 # usage: scripts/generalization_set.sh MONOMAP OUTDIR [DATA_DIR] [-- BUILD_ARGS...]
@@ -83,6 +84,13 @@ for half in "0 a" "150 b"; do
     --json "$OUT/eval_$name.json" >/dev/null
   "$BIN" eval planes "$OUT/map_$name" --plane "$DESK/groundtruth_structure.yaml" \
     --json "$OUT/evalplanes_$name.json" >/dev/null
+  # Issue 18's protocol: the points over the board, also in the ground
+  # truth's frame (the map's is the odometry's).
+  "$BIN" eval points "$OUT/map_$name" --plane "$DESK/groundtruth_structure.yaml" \
+    --over-board --json "$OUT/evalboard_$name.json" >/dev/null
+  "$BIN" eval points "$OUT/map_$name" --plane "$DESK/groundtruth_structure.yaml" \
+    --over-board --align sim3-poses --groundtruth "$DESK/groundtruth.txt" \
+    --json "$OUT/evalboard_sim3_$name.json" >/dev/null
   echo "  $name: $((SECONDS - t0)) s" >&2
 done
 CASTLE=$DATA/castle_visp

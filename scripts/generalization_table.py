@@ -86,10 +86,19 @@ def real_row(out, name):
     e = load(os.path.join(out, f"eval_{name}.json"))
     row = {"name": name, "build_s": int(open(os.path.join(out, f"time_{name}.txt")).read()),
            "eval_points": e}
-    p = os.path.join(out, f"evalplanes_{name}.json")
-    if os.path.exists(p):
-        row["eval_planes"] = load(p)
+    for key, file in (("eval_planes", "evalplanes"), ("board", "evalboard"),
+                      ("board_sim3", "evalboard_sim3")):
+        p = os.path.join(out, f"{file}_{name}.json")
+        if os.path.exists(p):
+            row[key] = load(p)
     return row
+
+
+def board_cell(e):
+    """Median (p90) % of distance and count of the points over the board."""
+    rel, ab = e["relative_percent"], e["absolute_m"]
+    return (f"{rel['median']:.2f} ({rel['p90']:.2f}); {1000 * ab['median']:.2f} mm;"
+            f" {rel['count']}")
 
 
 def find_stat(obj, want):
@@ -159,6 +168,13 @@ def main():
                 f" {a['precision']:.2f} | {100 * a['area_recall']:.0f} % | {pct(a['area_precision'])} |"
                 f" {a['large_planes_recovered']} / {a['large_planes_seen']} | {observable(a)} |"
                 f" {a['median_error_percent']:.2f} ({a['p90_error_percent']:.2f}) |")
+    boards = [r for r in reals if "board" in r and "board_sim3" in r]
+    if boards:
+        lines += ["", "Desk halves, the points over the board (issue 18's protocol:"
+                  " `eval points --over-board`): median % of distance (p90); mm; points.", "",
+                  "| run | absolute | after `--align sim3-poses` |", "|---|---|---|"]
+        for r in boards:
+            lines.append(f"| {r['name']} | {board_cell(r['board'])} | {board_cell(r['board_sim3'])} |")
     with open(os.path.join(out, "generalization.md"), "w") as f:
         f.write("\n".join(lines) + "\n")
     print("\n".join(lines))
