@@ -137,6 +137,12 @@ void AddPointTrustOptions(CLI::App* cmd, PointTrustOptions* o) {
                   "this angle (degrees)")
       ->check(CLI::Range(0.0, 179.9))
       ->capture_default_str();
+  cmd->add_option("--max-point-uncertainty", o->max_relative_uncertainty,
+                  "Export only points whose predicted standard deviation at "
+                  "1 px of tracking noise is at most this fraction of their "
+                  "depth (0: off)")
+      ->check(CLI::Range(0.0, 1e6))
+      ->capture_default_str();
 }
 
 void AddMappingOptions(CLI::App* cmd, BuildArgs* a) {
@@ -266,7 +272,7 @@ void RunBuild(const BuildArgs& a) {
                  result.report.num_frames, result.tracks.size(),
                  result.map.landmarks.size(),
                  trust.short_track + trust.reprojection_error +
-                     trust.triangulation_angle,
+                     trust.triangulation_angle + trust.uncertainty,
                  trust.keep_all ? "kept" : "left out", result.map.planes.size(),
                  result.report.total_seconds,
                  result.report.num_frames / result.report.total_seconds,

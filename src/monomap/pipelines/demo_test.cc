@@ -50,7 +50,9 @@ TEST(DemoReportTest, SmallHallwayDemo) {
   const DemoReport r = RunDemo(o);
 
   EXPECT_EQ(r.frames, 60);
-  EXPECT_GT(r.landmarks, 200);
+  // Exported (trusted) points: 195 at 320x240, where 1 px is 2 mrad and
+  // the export leaves out the loosest third.
+  EXPECT_GT(r.landmarks, 150);
   EXPECT_GE(r.structure.fitted_planes, 1);
   EXPECT_GE(r.structure.observed_true_planes, 1);
   EXPECT_GT(r.structure.recall, 0.0);

@@ -394,7 +394,8 @@ nlohmann::json ExportedPointsJson(const PointTrustReport& point_trust) {
           {point_trust.keep_all ? "untrusted_kept" : "left_out",
            {{"short_track", point_trust.short_track},
             {"reprojection_error", point_trust.reprojection_error},
-            {"triangulation_angle", point_trust.triangulation_angle}}}};
+            {"triangulation_angle", point_trust.triangulation_angle},
+            {"uncertainty", point_trust.uncertainty}}}};
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 #include "monomap/triangulation/point_trust.h"
 
+#include <Eigen/Eigenvalues>
 #include <cmath>
 
 #include "monomap/util/error.h"
@@ -16,7 +17,24 @@ void PointTrustOptions::Check() const {
   CheckOption(
       min_triangulation_angle_deg >= 0.0 && min_triangulation_angle_deg < 180.0,
       "point_trust.min_triangulation_angle_deg", "must be in [0, 180)");
+  CheckOption(std::isfinite(max_relative_uncertainty),
+              "point_trust.max_relative_uncertainty", "must be finite");
 }
+
+namespace {
+
+// Whether the point's own covariance is looser than the bound (false when
+// the bound is off or the covariance unknown).
+bool TooUncertain(const Landmark& l, double max_relative) {
+  if (max_relative <= 0.0 || l.covariance_m2_per_px2.isZero()) return false;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(
+      l.covariance_m2_per_px2, Eigen::EigenvaluesOnly);
+  const double sigma = std::sqrt(std::max(eig.eigenvalues()(2), 0.0));
+  // Written so that a NaN sigma or depth is too uncertain.
+  return !(sigma <= max_relative * l.mean_depth_m);
+}
+
+}  // namespace
 
 PointTrustReport FilterTrustedPoints(const PointTrustOptions& options,
                                      std::vector<Landmark>* landmarks) {
@@ -37,6 +55,8 @@ PointTrustReport FilterTrustedPoints(const PointTrustOptions& options,
     } else if (!(l.triangulation_angle_deg >=
                  options.min_triangulation_angle_deg)) {
       ++report.triangulation_angle;
+    } else if (TooUncertain(l, options.max_relative_uncertainty)) {
+      ++report.uncertainty;
     } else {
       trusted = true;
     }

@@ -2,7 +2,8 @@
 // points.ply. Triangulation already refuses points it cannot compute; this
 // stage leaves out, at export, the ones it computed but does not trust (few
 // observations, a large residual after bundle adjustment, rays too close to
-// parallel to fix the depth), judged on the quality each Landmark carries.
+// parallel to fix the depth, a position its own covariance says is loose),
+// judged on the quality each Landmark carries.
 #pragma once
 
 #include <vector>
@@ -21,6 +22,13 @@ struct PointTrustOptions {
   // Smallest largest angle between observing rays (degrees); as
   // triangulation's own limit, for the same reason.
   double min_triangulation_angle_deg = 1.5;
+  // Largest predicted standard deviation of a point along its loosest
+  // direction, at 1 px of tracking noise (the square root of the largest
+  // eigenvalue of Landmark::covariance_m2_per_px2), as a fraction of its
+  // mean depth. Depth, baseline and viewing geometry together, where the
+  // angle test sees the angle alone. <= 0: off. Points without a covariance
+  // pass.
+  double max_relative_uncertainty = 0.02;
   // Export every point; the report still counts the untrusted ones.
   bool keep_all = false;
   // Throws OptionsError naming the field if a value makes no sense.
@@ -35,6 +43,7 @@ struct PointTrustReport {
   int short_track = 0;
   int reprojection_error = 0;
   int triangulation_angle = 0;
+  int uncertainty = 0;
   bool keep_all = false;
 };
 

@@ -82,8 +82,9 @@ TEST(PointTrustTest, LeavesOutThePlantedBadPointsAndKeepsTheGoodOnes) {
     }
   }
   std::vector<Landmark> kept = all;
-  const PointTrustReport report =
-      FilterTrustedPoints(PointTrustOptions{}, &kept);
+  PointTrustOptions options;
+  options.max_relative_uncertainty = 0.0;  // its own test below
+  const PointTrustReport report = FilterTrustedPoints(options, &kept);
   EXPECT_EQ(report.num_points, static_cast<int>(all.size()));
   EXPECT_EQ(report.num_exported, kClean);
   EXPECT_EQ(report.short_track, kShort);
@@ -102,6 +103,7 @@ TEST(PointTrustTest, KeepAllExportsEveryPointAndCountsTheUntrusted) {
   std::vector<Landmark> kept = all;
   PointTrustOptions options;
   options.keep_all = true;
+  options.max_relative_uncertainty = 0.0;
   const PointTrustReport report = FilterTrustedPoints(options, &kept);
   EXPECT_TRUE(report.keep_all);
   EXPECT_EQ(report.num_exported, static_cast<int>(all.size()));
@@ -120,6 +122,7 @@ TEST(PointTrustTest, ThresholdsCountExactlyThePointsBeyondThem) {
   options.min_track_length = 12;
   options.max_mean_reprojection_error_px = 0.4;
   options.min_triangulation_angle_deg = 6.0;
+  options.max_relative_uncertainty = 0.0;
   int short_track = 0, error = 0, angle = 0;
   for (const Landmark& l : all) {
     if (l.num_observations < 12) {
@@ -156,6 +159,53 @@ TEST(PointTrustTest, ThresholdsCountExactlyThePointsBeyondThem) {
   EXPECT_TRUE(nan_point.empty());
 }
 
+// The points the uncertainty test leaves out are the ones that are really
+// off: of the clean simulated points (0.3 px noise), those whose predicted
+// sigma exceeds 2 % of their depth have larger true errors (relative to
+// depth) than those kept.
+TEST(PointTrustTest, UncertainPointsAreTheOnesThatAreOff) {
+  testing::TestSceneOptions scene_options;
+  scene_options.points.num_tracks = kClean;
+  scene_options.points.pixel_noise_px = 0.3;
+  scene_options.seed = 11;
+  const testing::TestScene scene = testing::MakeTestScene(scene_options);
+  const std::vector<Landmark> all = LandmarksWithPlantedBadPoints();
+  PointTrustOptions options;
+  options.min_track_length = 2;
+  options.max_mean_reprojection_error_px = 1e6;
+  options.min_triangulation_angle_deg = 0.0;
+  std::vector<Landmark> kept(all.begin(), all.begin() + kClean);
+  const PointTrustReport report = FilterTrustedPoints(options, &kept);
+  EXPECT_GT(report.uncertainty, 10);  // the scene has loose points
+  EXPECT_GT(report.num_exported, kClean / 2);
+  std::vector<double> kept_error, dropped_error;
+  std::vector<bool> is_kept(kClean, false);
+  for (const Landmark& l : kept) is_kept[l.id] = true;
+  for (int i = 0; i < kClean; ++i) {
+    const double e =
+        (all[i].x_in_world - scene.points[i]).norm() / all[i].mean_depth_m;
+    (is_kept[i] ? kept_error : dropped_error).push_back(e);
+  }
+  auto median = [](std::vector<double> v) {
+    std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+    return v[v.size() / 2];
+  };
+  EXPECT_GT(median(dropped_error), 3.0 * median(kept_error));
+  // No covariance: trusted; a NaN depth: not; the bound off: all kept.
+  std::vector<Landmark> special(3, all[0]);
+  special[0].covariance_m2_per_px2.setZero();
+  special[0].mean_depth_m = 1.0;
+  special[1].mean_depth_m = std::nan("");
+  special[2].covariance_m2_per_px2 = Eigen::Matrix3d::Identity();  // 1 m
+  std::vector<Landmark> out = special;
+  EXPECT_EQ(FilterTrustedPoints(options, &out).uncertainty, 2);
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_TRUE(out[0].covariance_m2_per_px2.isZero());
+  options.max_relative_uncertainty = 0.0;
+  out = special;
+  EXPECT_EQ(FilterTrustedPoints(options, &out).num_exported, 3);
+}
+
 TEST(PointTrustTest, CheckRejectsBadValues) {
   EXPECT_NO_THROW(PointTrustOptions{}.Check());
   auto error_of = [](const PointTrustOptions& o) -> std::string {
@@ -176,6 +226,9 @@ TEST(PointTrustTest, CheckRejectsBadValues) {
   o.max_mean_reprojection_error_px = std::nan("");
   EXPECT_NE(error_of(o).find("max_mean_reprojection_error_px"),
             std::string::npos);
+  o = {};
+  o.max_relative_uncertainty = std::nan("");
+  EXPECT_NE(error_of(o).find("max_relative_uncertainty"), std::string::npos);
   o = {};
   o.min_triangulation_angle_deg = -0.5;
   EXPECT_NE(error_of(o).find("min_triangulation_angle_deg"), std::string::npos);
