@@ -7,6 +7,7 @@
 #include "monomap/eval/checkerboard_accuracy.h"
 #include "monomap/eval/point_accuracy.h"
 #include "monomap/eval/report_json.h"
+#include "monomap/eval/structure_accuracy.h"
 #include "monomap/eval/trajectory_metrics.h"
 #include "monomap/exe/eval_commands.h"
 #include "monomap/io/map_format.h"
@@ -41,28 +42,35 @@ std::vector<Eigen::Vector3d> OverBoard(const std::vector<Eigen::Vector3d>& xs,
 
 // The map's points and trajectory moved into the ground truth's frame by
 // the alignment of its trajectory (a monocular map's frame and scale are
-// the odometry's), or left as they are with "none".
+// the odometry's): scaled (ScaledMap), then moved rigidly.
 void AlignToGroundTruth(const PointArgs& a, Map* map) {
-  if ((a.align != "none") != !a.groundtruth.empty()) {
-    throw OptionsError("eval points: --align and --groundtruth go together");
-  }
   if (a.align == "none") return;
   const Sim3d gt_from_map = AlignTrajectories(
       map->trajectory, ReadTumTrajectory(a.groundtruth),
       ParseAlignment(a.align == "first-pose" ? "first" : a.align));
+  *map = ScaledMap(*map, gt_from_map.scale);
   for (Landmark& l : map->landmarks) {
-    l.x_in_world = gt_from_map.rigid * (gt_from_map.scale * l.x_in_world);
+    l.x_in_world = gt_from_map.rigid * l.x_in_world;
   }
   for (TimedPose& p : map->trajectory) {
-    p.world_from_cam.translation *= gt_from_map.scale;
     p.world_from_cam = gt_from_map.rigid * p.world_from_cam;
   }
 }
 
-void RunEvalPoints(const PointArgs& a) {
+void CheckPointArgs(const PointArgs& a) {
   if (a.plane_yaml.empty() == a.surface_ply.empty()) {
     throw OptionsError("eval points: give exactly one of --plane or --surface");
   }
+  if (a.over_board && a.plane_yaml.empty()) {
+    throw OptionsError("eval points: --over-board needs --plane");
+  }
+  if ((a.align != "none") != !a.groundtruth.empty()) {
+    throw OptionsError("eval points: --align and --groundtruth go together");
+  }
+}
+
+void RunEvalPoints(const PointArgs& a) {
+  CheckPointArgs(a);
   Map map = ReadMap(a.map_dir);
   AlignToGroundTruth(a, &map);
   int label = a.plane_label;
@@ -70,9 +78,6 @@ void RunEvalPoints(const PointArgs& a) {
     const std::optional<int> largest = LargestPlaneLabel(map);
     if (!largest) throw StageError(a.map_dir + ": map has no plane labels");
     label = *largest;
-  }
-  if (a.over_board && a.plane_yaml.empty()) {
-    throw OptionsError("eval points: --over-board needs --plane");
   }
   std::vector<Eigen::Vector3d> xs = LandmarkPositions(map, label);
   if (a.over_board) xs = OverBoard(xs, a.plane_yaml);
