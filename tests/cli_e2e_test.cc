@@ -370,9 +370,10 @@ TEST_F(Cli, EvalStructurePrintsTheTableAndWritesJson) {
   EXPECT_NE(j["alignment_scale"].get<double>(), 1.0);
 }
 
-// build --grow-planes: the planes grow beyond their points over what the
-// images explain; the report says by how much, and more of the world's
-// seen structure is recovered while the grown area stays on it.
+// build --grow-planes: the planes grow beyond
+// their points over what the images explain; the report says by how much,
+// more of the world's seen structure is recovered while the grown area
+// stays on it, and the map keeps what the points support for localization.
 TEST_F(Cli, GrowPlanesRecoversMoreOfTheSeenStructure) {
   const fs::path data = *root_ / "data";
   double recall[2], precision[2];
@@ -389,6 +390,19 @@ TEST_F(Cli, GrowPlanesRecoversMoreOfTheSeenStructure) {
     for (const auto& p : growth["planes"]) {
       EXPECT_GE(p["area_after_m2"].get<double>(),
                 p["area_before_m2"].get<double>());
+    }
+    // A grown plane keeps its points' extent, inside the grown one.
+    int with_landmark_polygon = 0;
+    for (const TexturedPlane& p : ReadMap(map).planes) {
+      if (p.landmark_polygon.empty()) continue;
+      ++with_landmark_polygon;
+      EXPECT_LT(std::abs(PolygonArea(p.landmark_polygon)),
+                std::abs(PolygonArea(p.polygon)));
+    }
+    if (grow) {
+      EXPECT_GE(with_landmark_polygon, 1);
+    } else {
+      EXPECT_EQ(with_landmark_polygon, 0);
     }
     const fs::path json = *root_ / ("grow_eval" + std::to_string(grow) + ".json");
     r = RunMonomap("eval structure " + map.string() + " --structure " +

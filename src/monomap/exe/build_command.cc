@@ -167,7 +167,7 @@ void AddMappingOptions(CLI::App* cmd, BuildArgs* a) {
   cmd->add_flag("--grow-planes", a->grow_planes,
                 "Grow each plane's polygon over the image regions its plane "
                 "explains (photo-consistent across views), beyond its "
-                "points");
+                "points; localization renders only what the points support");
   cmd->add_option("--plane-growth-plain-run", o.growth.max_plain_run,
                   "Grown planes extend over plain (untextured) cells at "
                   "most this many cells from texture evidence")

@@ -224,9 +224,9 @@ void ReadPlaneFrame(const JsonFields& f, const json& p,
 }
 
 Polygon2d ReadPolygon(const JsonFields& f, const json& p,
-                      const std::string& field) {
-  const std::string polygon_field = JsonFields::Join(field, "polygon");
-  const json& polygon = f.Array(p, field, "polygon");
+                      const std::string& field, const char* key = "polygon") {
+  const std::string polygon_field = JsonFields::Join(field, key);
+  const json& polygon = f.Array(p, field, key);
   if (polygon.size() < 3) {
     f.Fail(polygon_field, "needs at least 3 vertices, got " +
                               std::to_string(polygon.size()));
@@ -301,6 +301,10 @@ TexturedPlane ReadPlane(const JsonFields& f, const json& p,
     f.Fail(JsonFields::Join(field, "pixels_per_meter"), "must be positive");
   }
   plane.polygon = ReadPolygon(f, p, field);
+  // Optional: written only for grown planes (older maps have none).
+  if (p.contains("landmark_polygon")) {
+    plane.landmark_polygon = ReadPolygon(f, p, field, "landmark_polygon");
+  }
   plane.features = ReadPlaneFeatures(f, p, field);
   plane.texture = ReadPlaneTexture(f, p, field, dir);
   return plane;
@@ -333,6 +337,10 @@ std::string FormatMapJson(const Map& map) {
   for (const TexturedPlane& p : map.planes) {
     OrderedJson polygon = OrderedJson::array();
     for (const auto& st : p.polygon) polygon.push_back(VectorJson(st));
+    OrderedJson landmark_polygon = OrderedJson::array();
+    for (const auto& st : p.landmark_polygon) {
+      landmark_polygon.push_back(VectorJson(st));
+    }
     OrderedJson features = OrderedJson::array();
     for (const PlaneFeature& feature : p.features) {
       features.push_back({{"id", feature.id},
@@ -347,8 +355,11 @@ std::string FormatMapJson(const Map& map) {
                       {"u_axis", VectorJson(p.frame.u_axis)},
                       {"v_axis", VectorJson(p.frame.v_axis)},
                       {"pixels_per_meter", p.pixels_per_meter},
-                      {"polygon", std::move(polygon)},
-                      {"features", std::move(features)}});
+                      {"polygon", std::move(polygon)}});
+    if (!p.landmark_polygon.empty()) {
+      planes.back()["landmark_polygon"] = std::move(landmark_polygon);
+    }
+    planes.back()["features"] = std::move(features);
   }
   root["planes"] = std::move(planes);
   root["num_landmarks"] = map.landmarks.size();

@@ -57,6 +57,8 @@ Map MakeTestMap() {
   wall.texture = RandomTexture(33, 17, 2);
   wall.polygon = {{0, 0}, {0.5, 0}, {0.5, 0.1}, {0.1, 0.1}, {0.1, 0.25},
                   {0, 0.25}};
+  // Grown: the part its landmarks support.
+  wall.landmark_polygon = {{0, 0}, {0.5, 0}, {0.5, 0.1}, {0, 0.1}};
   wall.features = {{5, wall.frame.ToWorld({0.05, 0.2}),
                     wall.TextureFromWorld(wall.frame.ToWorld({0.05, 0.2}))}};
   map.planes = {ground, wall};
@@ -151,6 +153,9 @@ TEST(MapFormatTest, RoundTripKeepsEveryField) {
     EXPECT_EQ(b.frame.v_axis, a.frame.v_axis);
     EXPECT_EQ(b.pixels_per_meter, a.pixels_per_meter);
     EXPECT_EQ(b.polygon, a.polygon);
+    EXPECT_EQ(b.landmark_polygon, a.landmark_polygon);
+    EXPECT_EQ(j["planes"][i].contains("landmark_polygon"),
+              !a.landmark_polygon.empty());
     ASSERT_EQ(b.features.size(), a.features.size());
     for (size_t k = 0; k < a.features.size(); ++k) {
       EXPECT_EQ(b.features[k].id, a.features[k].id);
@@ -312,6 +317,9 @@ TEST(MapFormatTest, InvalidFieldsAreNamed) {
       {"bad_polygon",
        [](json& j) { j["planes"][1]["polygon"][2] = {0.5, "x"}; },
        {"field 'planes[1].polygon[2][1]'", "expected a number"}},
+      {"short_landmark_polygon",
+       [](json& j) { j["planes"][0]["landmark_polygon"] = {{0, 0}, {1, 0}}; },
+       {"field 'planes[0].landmark_polygon'", "at least 3 vertices"}},
       {"bad_feature",
        [](json& j) { j["planes"][0]["features"][1]["xyz"] = {1, 2, 3, 4}; },
        {"field 'planes[0].features[1].xyz'", "expected 3 numbers"}},

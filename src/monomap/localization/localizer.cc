@@ -11,6 +11,12 @@
 
 namespace monomap {
 
+RendererOptions LocalizationRendererOptions() {
+  RendererOptions options;
+  options.clip_to_landmark_polygon = true;
+  return options;
+}
+
 namespace {
 
 // CPU seconds used by the process so far (all threads).

@@ -82,6 +82,12 @@ struct InitializationOptions {
   void Check() const;
 };
 
+// The renderer localization compares live images with: the defaults, but
+// each plane clipped to the part its landmarks support. Grown plain areas
+// carry no pose information and flatten the likelihood (desk MCC 2.03 ->
+// 2.44 mm with them; docs/design-notes.md, "Planes").
+RendererOptions LocalizationRendererOptions();
+
 struct LocalizerOptions {
   // Plain MCL, or MCL with Monte Carlo Correction of the best particles.
   LocalizationMethod method = LocalizationMethod::kMcl;
@@ -93,7 +99,7 @@ struct LocalizerOptions {
   MccCorrectionOptions mcc;
   RecoveryOptions recovery;
   InitializationOptions init;
-  RendererOptions renderer;
+  RendererOptions renderer = LocalizationRendererOptions();
   uint64_t seed = 1;
 
   void Check() const;

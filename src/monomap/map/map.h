@@ -64,6 +64,9 @@ struct PlaneSegment {
   std::vector<Eigen::Vector2d> inlier_st;
   // Bounded extent in (s, t) plane coordinates (metres).
   Polygon2d polygon;
+  // The extent its landmarks support, when plane growth enlarged `polygon`
+  // beyond it; empty otherwise (then it is `polygon`).
+  Polygon2d landmark_polygon;
   // RMS point-to-plane distance of the inliers (m).
   double rms_distance_m = 0.0;
 };
@@ -93,6 +96,10 @@ struct TexturedPlane {
   cv::Mat texture;
   // Extent as a polygon of (s, t) plane coordinates in metres.
   Polygon2d polygon;
+  // The part of it its landmarks support, when plane growth enlarged it;
+  // empty otherwise (then the whole polygon). Localization renders this
+  // part only (RendererOptions::clip_to_landmark_polygon).
+  Polygon2d landmark_polygon;
   std::vector<PlaneFeature> features;
 
   // World point -> texture pixel coordinates (column, row) and back.

@@ -341,8 +341,9 @@ cv::Mat1b ClaimedByOthers(const PlaneGrowthOptions& o, const PlaneSegment& seg,
 cv::Mat1b Grow(const PlaneGrowthOptions& o, const Grid& grid,
                const cv::Mat1b& inside, const cv::Mat1i& carved,
                const cv::Mat1b& claimed, const CellJudge& judge,
-               PlaneGrowthStats* stats) {
+               PlaneGrowthStats* stats, cv::Mat1b* proof) {
   cv::Mat1b member = inside.clone();
+  *proof = inside.clone();
   cv::Mat1i run(grid.rows, grid.cols, 0);
   cv::Mat1b tried = inside.clone();
   static const int kDr[4] = {-1, 1, 0, 0}, kDc[4] = {0, 0, -1, 1};
@@ -381,6 +382,7 @@ cv::Mat1b Grow(const PlaneGrowthOptions& o, const Grid& grid,
       }
       if (evidence[i] == Evidence::kTextured) {
         run(p.y, p.x) = 0;
+        (*proof)(p.y, p.x) = 1;
         ++stats->cells_textured;
       } else if (evidence[i] == Evidence::kPlain && best_run < o.max_plain_run) {
         run(p.y, p.x) = best_run + 1;
@@ -423,6 +425,33 @@ SegmentGrid PrepareGrid(const PlaneGrowthOptions& o, const PlaneSegment& seg,
   return g;
 }
 
+// Leaves out the plain members outside the convex hull of the proof cells
+// (the fitted polygon's and the textured ones): plain paint agrees with
+// any plane, so it may only fill between proofs, never extend past them.
+void KeepPlainBetweenProofs(const cv::Mat1b& proof, cv::Mat1b* member,
+                            PlaneGrowthStats* stats) {
+  std::vector<cv::Point2f> centres;
+  for (int r = 0; r < proof.rows; ++r) {
+    for (int c = 0; c < proof.cols; ++c) {
+      if (proof(r, c)) centres.emplace_back(c, r);
+    }
+  }
+  std::vector<cv::Point2f> hull;
+  if (!centres.empty()) cv::convexHull(centres, hull);
+  for (int r = 0; r < member->rows; ++r) {
+    for (int c = 0; c < member->cols; ++c) {
+      if (!(*member)(r, c) || proof(r, c)) continue;
+      // Half a cell of slack: a plain cell beside the hull's edge stays.
+      const bool within = hull.size() >= 3 &&
+          cv::pointPolygonTest(hull, cv::Point2f(c, r), true) >= -0.5;
+      if (!within) {
+        (*member)(r, c) = 0;
+        --stats->cells_plain;
+      }
+    }
+  }
+}
+
 // Grows one segment (its fitted polygon) against the others (occluders).
 // Returns the new polygon, or the fitted one if nothing grew.
 Polygon2d GrowSegment(const PlaneGrowthOptions& o, const PlaneSegment& seg,
@@ -437,7 +466,10 @@ Polygon2d GrowSegment(const PlaneGrowthOptions& o, const PlaneSegment& seg,
   stats->cells_carved = cv::countNonZero(g.carved >= o.min_carving_landmarks);
   const CellJudge judge(o, seg, grid, views, occluders, projector);
   const cv::Mat1b claimed = ClaimedByOthers(o, seg, grid, occluders);
-  cv::Mat1b member = Grow(o, grid, g.inside, g.carved, claimed, judge, stats);
+  cv::Mat1b proof;
+  cv::Mat1b member =
+      Grow(o, grid, g.inside, g.carved, claimed, judge, stats, &proof);
+  if (o.plain_between_proofs) KeepPlainBetweenProofs(proof, &member, stats);
   if (stats->cells_textured + stats->cells_plain == 0) return seg.polygon;
   member *= 255;
   if (o.close_cells > 0) {
@@ -532,6 +564,12 @@ PlaneGrowthReport GrowPlanePolygons(
       }
       report.planes.push_back(stats);
     }
+  }
+  // What the landmarks alone support, for localization (TexturedPlane).
+  for (size_t i = 0; i < segments->size(); ++i) {
+    PlaneSegment& seg = (*segments)[i];
+    seg.landmark_polygon.clear();
+    if (seg.polygon != original[i]) seg.landmark_polygon = original[i];
   }
   report.seconds = timer.ElapsedSeconds();
   return report;

@@ -33,10 +33,11 @@
 namespace monomap {
 
 struct PlaneGrowthOptions {
-  // Grow polygons at all. Off by default: over the simulated worlds it
-  // recovers 41 % more of the seen structure, but on the real desk the
-  // grown texture moves MCC localization from 2.03 to 2.44 mm
-  // (docs/design-notes.md, "Planes").
+  // Grow polygons at all (the polygon before growth is kept as
+  // PlaneSegment::landmark_polygon, which localization renders). Off by
+  // default: over the simulated worlds it recovers 36 % more of the seen
+  // structure, but it also changes the texture resolution of the supported
+  // part (docs/design-notes.md, "Planes").
   bool enabled = false;
   // Cell side in image pixels at the plane's median view resolution, so the
   // grid is scale-free (a desk and a hallway get the same image support).
@@ -66,6 +67,9 @@ struct PlaneGrowthOptions {
   double max_plain_brightness_diff = 0.12;
   // Plain cells may extend at most this many cells from texture evidence.
   int max_plain_run = 8;
+  // ... and must lie within the convex hull of the fitted polygon and the
+  // textured cells: they fill between proofs, never extend past them.
+  bool plain_between_proofs = true;
   // A cell crossed by the viewing rays of at least this many landmarks
   // behind the plane is free space.
   int min_carving_landmarks = 2;

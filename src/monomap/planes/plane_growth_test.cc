@@ -91,6 +91,8 @@ TEST(PlaneGrowth, GrowsOverTheTexturedWallAndStopsAtItsEdges) {
   // slack around the wall's rectangle.
   const double c = s.cell_m;
   EXPECT_GT(ShareInside(segments[0].polygon, -c, 3 + c, -c, 1.2 + c), 0.97);
+  // The fitted polygon stays, as what the landmarks support.
+  EXPECT_NEAR(std::abs(PolygonArea(segments[0].landmark_polygon)), 0.12, 1e-9);
 }
 
 TEST(PlaneGrowth, AWrongPlaneDoesNotGrow) {
@@ -110,8 +112,9 @@ TEST(PlaneGrowth, AWrongPlaneDoesNotGrow) {
 
 TEST(PlaneGrowth, PlainCellsOnlyBridgeAndLandmarksBehindCarveFreeSpace) {
   TestScene scene = Room();
-  // Flat grey images: every cell is plain and consistent, so growth goes
-  // exactly max_plain_run cells beyond the patch in every direction.
+  // Flat grey images: every cell is plain and consistent. By default plain
+  // cells only fill between proofs (the patch, textured cells): none here,
+  // so the polygon stays the patch.
   for (cv::Mat& img : scene.images) img.setTo(cv::Scalar::all(128));
   PlaneGrowthOptions options = GrowthOn();
   options.max_plain_run = 3;
@@ -119,6 +122,15 @@ TEST(PlaneGrowth, PlainCellsOnlyBridgeAndLandmarksBehindCarveFreeSpace) {
   PlaneGrowthReport report =
       GrowPlanePolygons(options, scene.camera, scene.world_from_cam, {}, {},
                         Loader(scene), &segments);
+  EXPECT_EQ(report.planes[0].cells_textured, 0);
+  EXPECT_EQ(report.planes[0].cells_plain, 0);
+  EXPECT_NEAR(report.planes[0].area_after_m2, 0.12, 1e-9);
+  // Without that rule growth goes exactly max_plain_run cells beyond the
+  // patch in every direction.
+  options.plain_between_proofs = false;
+  segments = {FrontWallPatch(scene, 0.0)};
+  report = GrowPlanePolygons(options, scene.camera, scene.world_from_cam, {},
+                             {}, Loader(scene), &segments);
   const double c = report.planes[0].cell_m;
   EXPECT_EQ(report.planes[0].cells_textured, 0);
   Eigen::Vector2d lo, hi;
@@ -153,15 +165,18 @@ TEST(PlaneGrowth, PlainCellsOnlyBridgeAndLandmarksBehindCarveFreeSpace) {
   EXPECT_NEAR(hi.x(), 1.7 + 3 * c, 1.0 * c);
 }
 
-TEST(PlaneGrowth, OffByDefault) {
+TEST(PlaneGrowth, DisabledLeavesThePolygons) {
   const TestScene scene = Room();
   std::vector<PlaneSegment> segments = {FrontWallPatch(scene, 0.0)};
   const Polygon2d before = segments[0].polygon;
+  PlaneGrowthOptions off;
+  off.enabled = false;
   const PlaneGrowthReport report =
-      GrowPlanePolygons(PlaneGrowthOptions(), scene.camera,
+      GrowPlanePolygons(off, scene.camera,
                         scene.world_from_cam, {}, {}, Loader(scene), &segments);
   EXPECT_TRUE(report.planes.empty());
   EXPECT_EQ(segments[0].polygon, before);
+  EXPECT_TRUE(segments[0].landmark_polygon.empty());
 }
 
 TEST(PlaneGrowth, OptionsAreChecked) {

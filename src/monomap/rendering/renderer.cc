@@ -177,12 +177,16 @@ Renderer::Renderer(const std::vector<TexturedPlane>& planes,
     Eigen::Vector2d hi(bgra.cols / ppm, bgra.rows / ppm);
 
     cv::Mat mask(bgra.size(), CV_8U, cv::Scalar(255));
-    if (options_.clip_to_polygon && plane.polygon.size() >= 3) {
+    const Polygon2d& polygon = options_.clip_to_landmark_polygon &&
+                                       plane.landmark_polygon.size() >= 3
+                                   ? plane.landmark_polygon
+                                   : plane.polygon;
+    if (options_.clip_to_polygon && polygon.size() >= 3) {
       // fillPoly marks the texels whose centres are inside; vertices in
       // texel coordinates with 8 fractional bits.
       constexpr int kShift = 8;
       std::vector<cv::Point> pts;
-      for (const Eigen::Vector2d& st : plane.polygon) {
+      for (const Eigen::Vector2d& st : polygon) {
         const Eigen::Vector2d px = st * ppm - Eigen::Vector2d(0.5, 0.5);
         pts.emplace_back(static_cast<int>(std::lround(px.x() * (1 << kShift))),
                          static_cast<int>(std::lround(px.y() * (1 << kShift))));
@@ -191,7 +195,7 @@ Renderer::Renderer(const std::vector<TexturedPlane>& planes,
       cv::fillPoly(mask, std::vector<std::vector<cv::Point>>{pts},
                    cv::Scalar(255), cv::LINE_8, kShift);
       Eigen::Vector2d pmin, pmax;
-      PolygonBounds(plane.polygon, &pmin, &pmax);
+      PolygonBounds(polygon, &pmin, &pmax);
       lo = lo.cwiseMax(pmin);
       hi = hi.cwiseMin(pmax);
       if (lo.x() > hi.x() || lo.y() > hi.y()) continue;  // nothing inside

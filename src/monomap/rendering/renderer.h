@@ -55,6 +55,10 @@ struct RendererOptions {
   // Texels whose centre lies outside TexturedPlane::polygon get alpha 0
   // (a polygon with fewer than 3 vertices means the whole texture).
   bool clip_to_polygon = true;
+  // ... to TexturedPlane::landmark_polygon instead, where a plane has one
+  // (the part of a grown polygon its landmarks support): localization's
+  // choice (LocalizationRendererOptions).
+  bool clip_to_landmark_polygon = false;
 
   // Throws OptionsError naming the field if a value makes no sense.
   void Check() const;

@@ -240,6 +240,47 @@ TEST(RendererTest, PolygonAndUnseenTexelsShowBackground) {
   }
 }
 
+// A grown plane keeps the extent its landmarks support: rendered whole by
+// default, clipped to that extent for localization.
+TEST(RendererTest, LandmarkPolygonClipsOnlyWhenAsked) {
+  TexturedPlane plane =
+      MakePlane(Vector3d(-0.5, -0.5, 0), Vector3d::UnitX(), Vector3d::UnitY(),
+                200, 200, 200, [](double, double) { return 80.0; });
+  plane.polygon = {Vector2d(0, 0), Vector2d(1, 0), Vector2d(1, 1),
+                   Vector2d(0, 1)};
+  // The left half (s < 0.5): what the landmarks support.
+  plane.landmark_polygon = {Vector2d(0, 0), Vector2d(0.5, 0),
+                            Vector2d(0.5, 1), Vector2d(0, 1)};
+  const Camera cam = TestCamera().Scaled(160, 120);
+  const Rigid3d pose = LookAt(Vector3d(0.01, -0.02, 0.8), Vector3d(0, 0, 0),
+                              Vector3d::UnitY());
+  int drawn[2][2] = {{0, 0}, {0, 0}};  // [clip][s >= 0.5]
+  for (int clip = 0; clip < 2; ++clip) {
+    RendererOptions options;
+    options.clip_to_landmark_polygon = clip == 1;
+    const Renderer renderer({plane}, options);
+    cv::Mat grey, depth;
+    renderer.Render(cam, pose, &grey, &depth);
+    for (int v = 0; v < cam.height; ++v) {
+      for (int u = 0; u < cam.width; ++u) {
+        Vector3d x;
+        double z = 0;
+        if (!CastToHorizontalPlane(cam, pose, u, v, 0.0, &x, &z)) continue;
+        const double s = x.x() + 0.5, t = x.y() + 0.5;
+        if (t < 0.02 || t > 0.98 || s < 0.02 || s > 0.98 ||
+            std::abs(s - 0.5) < 0.02) {
+          continue;  // near an edge
+        }
+        drawn[clip][s >= 0.5] += depth.at<float>(v, u) > 0 ? 1 : 0;
+      }
+    }
+  }
+  EXPECT_GT(drawn[0][0], 1000);
+  EXPECT_GT(drawn[0][1], 1000);
+  EXPECT_EQ(drawn[1][0], drawn[0][0]);  // the supported half: all of it
+  EXPECT_EQ(drawn[1][1], 0);            // the grown half: none of it
+}
+
 // Variance of the foreground pixels.
 double ForegroundVariance(const cv::Mat& grey, const cv::Mat& depth,
                           int* count) {

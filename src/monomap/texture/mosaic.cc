@@ -543,6 +543,9 @@ TexturedPlane BuildTexturedPlane(
   tp.texture =
       BlendTexture(sampler, frames, width, height, in.options, &inside, &seen);
   for (const auto& v : seg.polygon) tp.polygon.push_back(v - lo);
+  for (const auto& v : seg.landmark_polygon) {
+    tp.landmark_polygon.push_back(v - lo);
+  }
   const std::vector<double> residuals =
       AddPlaneFeatures(in.camera, seg, lo, all_views, in.landmarks,
                        in.track_by_id, in.landmark_by_id, &tp);
