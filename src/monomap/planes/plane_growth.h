@@ -35,9 +35,8 @@ namespace monomap {
 struct PlaneGrowthOptions {
   // Grow polygons at all (the polygon before growth is kept as
   // PlaneSegment::landmark_polygon, which localization renders). Off by
-  // default: over the simulated worlds it recovers 36 % more of the seen
-  // structure, but it also changes the texture resolution of the supported
-  // part (docs/design-notes.md, "Planes").
+  // default: on small maps grown areas can reach over a neighbouring
+  // surface (docs/design-notes.md, "Planes").
   bool enabled = false;
   // Cell side in image pixels at the plane's median view resolution, so the
   // grid is scale-free (a desk and a hallway get the same image support).
