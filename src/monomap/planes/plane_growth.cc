@@ -11,6 +11,7 @@
 
 #include "monomap/camera/distorted_projector.h"
 #include "monomap/geometry/polygon.h"
+#include "monomap/util/image_sampling.h"
 #include "monomap/planes/cell_outline.h"
 #include "monomap/util/angles.h"
 #include "monomap/util/error.h"
@@ -82,18 +83,6 @@ bool Hidden(const std::vector<const PlaneSegment*>& occluders,
   return false;
 }
 
-float Bilinear(const cv::Mat1b& img, const Eigen::Vector2d& px) {
-  const int x0 = std::min(static_cast<int>(px.x()), img.cols - 2);
-  const int y0 = std::min(static_cast<int>(px.y()), img.rows - 2);
-  const float ax = static_cast<float>(px.x() - x0);
-  const float ay = static_cast<float>(px.y() - y0);
-  const uint8_t* r0 = img.ptr<uint8_t>(y0) + x0;
-  const uint8_t* r1 = img.ptr<uint8_t>(y0 + 1) + x0;
-  const float top = r0[0] + ax * (r0[1] - r0[0]);
-  const float bottom = r1[0] + ax * (r1[1] - r1[0]);
-  return top + ay * (bottom - top);
-}
-
 // The grid of one segment: cell (r, c) covers plane coordinates
 // lo + cell * (c, r) and one cell more.
 struct Grid {
@@ -149,7 +138,10 @@ class CellJudge {
         ok = projector_.Project(v.cam_from_world * seg_.frame.ToWorld(st),
                                 &px) &&
              camera.InImage(px, 1.0);
-        if (ok) patches.push_back(Bilinear(v.grey, px));
+        if (ok) {
+          patches.push_back(SampleGreyBilinear(
+              v.grey, static_cast<float>(px.x()), static_cast<float>(px.y())));
+        }
       }
       if (!ok) {
         patches.resize(start);

@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "monomap/util/error.h"
+#include "monomap/util/image_sampling.h"
 
 namespace monomap {
 
@@ -24,18 +25,8 @@ void AffineRefinementOptions::Check() const {
 
 namespace {
 
-// Bilinear sample of an 8-bit image; (x, y) must satisfy 0 <= x < cols - 1
-// and 0 <= y < rows - 1.
-inline float Sample(const cv::Mat& img, float x, float y) {
-  const int x0 = static_cast<int>(x), y0 = static_cast<int>(y);
-  const float fx = x - x0, fy = y - y0;
-  const uchar* r0 = img.ptr<uchar>(y0) + x0;
-  const uchar* r1 = r0 + img.step[0];
-  return (1.0f - fy) * ((1.0f - fx) * r0[0] + fx * r0[1]) +
-         fy * ((1.0f - fx) * r1[0] + fx * r1[1]);
-}
-
-// Whether the parallelogram A [-h, h]^2 + t lies where Sample() may read.
+// Whether the parallelogram A [-h, h]^2 + t lies where SampleGreyBilinear()
+// reads inside the image.
 bool WarpInside(const cv::Mat& img, const Eigen::Matrix2f& a,
                 const Eigen::Vector2f& t, float h) {
   for (const float sx : {-h, h}) {
@@ -66,8 +57,8 @@ bool FeatureTemplate::Extract(const cv::Mat& grey,
   std::vector<float> patch(static_cast<size_t>(side) * side);
   for (int y = 0; y < side; ++y) {
     for (int x = 0; x < side; ++x) {
-      patch[y * side + x] =
-          Sample(grey, center.x() + (x - r - 1), center.y() + (y - r - 1));
+      patch[y * side + x] = SampleGreyBilinear(
+          grey, center.x() + (x - r - 1), center.y() + (y - r - 1));
     }
   }
   double sum = 0.0, sum2 = 0.0;
@@ -128,7 +119,8 @@ namespace {
 
 // Resamples the image under the warp (A, t) over [-r, r]^2 into samples,
 // row by row (the offsets of a row advance by A's first column); sets their
-// mean and variance. The warp must lie where Sample() may read.
+// mean and variance. The warp must lie where SampleGreyBilinear() reads
+// inside the image.
 void SampleWarpedPatch(const cv::Mat& grey, const Eigen::Matrix2f& a,
                        const Eigen::Vector2f& t, int r,
                        std::vector<float>* samples, double* mean, double* var) {
@@ -138,7 +130,7 @@ void SampleWarpedPatch(const cv::Mat& grey, const Eigen::Matrix2f& a,
     Eigen::Vector2f p = a * Eigen::Vector2f(-r, y) + t;
     const Eigen::Vector2f step = a.col(0);
     for (int x = -r; x <= r; ++x, ++k, p += step) {
-      const float v = Sample(grey, p.x(), p.y());
+      const float v = SampleGreyBilinear(grey, p.x(), p.y());
       (*samples)[k] = v;
       sum += v;
       sum2 += static_cast<double>(v) * v;
