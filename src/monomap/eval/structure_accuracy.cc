@@ -37,6 +37,7 @@ Map ScaledMap(const Map& map, double scale) {
     p.frame.origin *= scale;
     p.pixels_per_meter /= scale;
     for (Eigen::Vector2d& v : p.polygon) v *= scale;
+    for (Eigen::Vector2d& v : p.landmark_polygon) v *= scale;
     for (PlaneFeature& f : p.features) f.x_in_world *= scale;
   }
   for (TimedPose& t : out.trajectory) {

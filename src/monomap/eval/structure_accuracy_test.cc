@@ -327,6 +327,7 @@ TEST(StructureAccuracyTest, ScaledMapUndoesAnOdometryScaleError) {
   for (TexturedPlane& p : map.planes) {
     p.frame = MakePlaneFrame(p.plane, {1, 1, 1}, {0, 0, 1});
     p.polygon = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+    p.landmark_polygon = {{0, 0}, {0.5, 0}, {0.5, 1}, {0, 1}};
     p.pixels_per_meter = 100;
   }
   map.trajectory.push_back({0.0, Rigid3d::Identity()});
@@ -346,6 +347,9 @@ TEST(StructureAccuracyTest, ScaledMapUndoesAnOdometryScaleError) {
                map.planes[1].WorldFromTexture(px) / 1.03)
                   .norm(),
               0.0, 1e-12);
+  // Both outlines scale with the plane (a grown plane's supported part too).
+  EXPECT_NEAR(back.planes[1].polygon[2].x(), 1 / 1.03, 1e-12);
+  EXPECT_NEAR(back.planes[1].landmark_polygon[1].x(), 0.5 / 1.03, 1e-12);
   EXPECT_NEAR(back.landmarks[0].mean_depth_m, 2.0, 1e-12);
   EXPECT_NEAR(back.trajectory[0].world_from_cam.translation.z(), 3 / 1.03,
               1e-12);

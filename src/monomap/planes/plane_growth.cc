@@ -11,10 +11,10 @@
 
 #include "monomap/camera/distorted_projector.h"
 #include "monomap/geometry/polygon.h"
-#include "monomap/util/image_sampling.h"
 #include "monomap/planes/cell_outline.h"
 #include "monomap/util/angles.h"
 #include "monomap/util/error.h"
+#include "monomap/util/image_sampling.h"
 #include "monomap/util/stats.h"
 #include "monomap/util/progress.h"
 
