@@ -387,6 +387,18 @@ TEST_F(Cli, GrowPlanesRecoversMoreOfTheSeenStructure) {
     std::ifstream report_in(report);
     const nlohmann::json growth = nlohmann::json::parse(report_in)["plane_growth"];
     EXPECT_EQ(growth["planes"].size(), grow ? ReadMap(map).planes.size() : 0u);
+    // Plane hypotheses are checked only with growth; a confirmed one is a
+    // map plane.
+    ASSERT_TRUE(growth["hypotheses"].is_array());
+    if (!grow) {
+      EXPECT_TRUE(growth["hypotheses"].empty());
+    }
+    for (const auto& h : growth["hypotheses"]) {
+      EXPECT_GE(h["inliers"].get<int>(), 5);
+      EXPECT_EQ(h["confirmed"].get<bool>(), h["plane_id"].get<int>() >= 0);
+      EXPECT_LT(h["plane_id"].get<int>(),
+                static_cast<int>(ReadMap(map).planes.size()));
+    }
     for (const auto& p : growth["planes"]) {
       EXPECT_GE(p["area_after_m2"].get<double>(),
                 p["area_before_m2"].get<double>());

@@ -29,6 +29,7 @@ struct BuildArgs {
   bool no_affine = false;
   bool merge_coplanar = false;  // planes.merge_coplanar + local_ghost_test
   bool grow_planes = false;
+  bool no_plane_hypotheses = false;
   bool no_direction_snap = false;
   bool quiet = false;
   bool drop_odometry_jumps = false;
@@ -145,29 +146,17 @@ void AddPointTrustOptions(CLI::App* cmd, PointTrustOptions* o) {
       ->capture_default_str();
 }
 
-void AddMappingOptions(CLI::App* cmd, BuildArgs* a) {
+// Plane growth (opt-in) and the plane hypotheses it checks.
+void AddGrowthOptions(CLI::App* cmd, BuildArgs* a) {
   MappingOptions& o = a->options;
-  cmd->add_flag("--no-ba", a->no_bundle_adjustment,
-                "Skip bundle adjustment (keep odometry poses)");
-  cmd->add_flag("--points-only", o.points_only,
-                "Stop after triangulation and bundle adjustment");
-  cmd->add_option("--ransac-iterations", o.planes.ransac_iterations,
-                  "RANSAC hypotheses per plane")
-      ->capture_default_str();
-  cmd->add_flag("--merge-coplanar", a->merge_coplanar,
-                "Merge plane segments that are one physical plane, and keep "
-                "surfaces beside a plane (a recessed door) apart");
-  cmd->add_flag("--no-direction-snap", a->no_direction_snap,
-                "Keep every plane's least-squares normal; by default a plane "
-                "whose points allow it takes the direction of the scene's "
-                "well-measured planes or one at right angles to them");
-  cmd->add_option("--snap-max-angle", o.planes.snap_max_angle_deg,
-                  "Largest angle (deg) a plane's normal is snapped by")
-      ->capture_default_str();
   cmd->add_flag("--grow-planes", a->grow_planes,
                 "Grow each plane's polygon over the image regions its plane "
                 "explains (photo-consistent across views), beyond its "
                 "points; localization renders only what the points support");
+  cmd->add_flag("--no-plane-hypotheses", a->no_plane_hypotheses,
+                "With --grow-planes: do not propose planes along the scene's "
+                "directions through the points on no plane (kept only where "
+                "the images confirm them)");
   cmd->add_option("--plane-growth-plain-run", o.growth.max_plain_run,
                   "Grown planes extend over plain (untextured) cells at "
                   "most this many cells from texture evidence")
@@ -199,6 +188,28 @@ void AddMappingOptions(CLI::App* cmd, BuildArgs* a) {
                   "cells outside its polygon")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
+}
+
+void AddMappingOptions(CLI::App* cmd, BuildArgs* a) {
+  MappingOptions& o = a->options;
+  cmd->add_flag("--no-ba", a->no_bundle_adjustment,
+                "Skip bundle adjustment (keep odometry poses)");
+  cmd->add_flag("--points-only", o.points_only,
+                "Stop after triangulation and bundle adjustment");
+  cmd->add_option("--ransac-iterations", o.planes.ransac_iterations,
+                  "RANSAC hypotheses per plane")
+      ->capture_default_str();
+  cmd->add_flag("--merge-coplanar", a->merge_coplanar,
+                "Merge plane segments that are one physical plane, and keep "
+                "surfaces beside a plane (a recessed door) apart");
+  cmd->add_flag("--no-direction-snap", a->no_direction_snap,
+                "Keep every plane's least-squares normal; by default a plane "
+                "whose points allow it takes the direction of the scene's "
+                "well-measured planes or one at right angles to them");
+  cmd->add_option("--snap-max-angle", o.planes.snap_max_angle_deg,
+                  "Largest angle (deg) a plane's normal is snapped by")
+      ->capture_default_str();
+  AddGrowthOptions(cmd, a);
   cmd->add_option("--keyframe-interval", o.keyframes.interval,
                   "Bundle-adjust every n-th frame (1: all frames)")
       ->capture_default_str();
@@ -250,6 +261,7 @@ void RunBuild(const BuildArgs& a) {
   options.planes.merge_coplanar = a.merge_coplanar;
   options.planes.local_ghost_test = a.merge_coplanar;
   options.growth.enabled = a.grow_planes;
+  options.hypotheses.enabled = !a.no_plane_hypotheses;
   options.planes.snap_to_directions = !a.no_direction_snap;
   options.show_progress = !a.quiet;
   const MappingResult result = BuildMap(dataset, options);

@@ -20,6 +20,7 @@ void MappingOptions::Check() const {
   bundle_adjustment.Check();
   planes.Check();
   growth.Check();
+  hypotheses.Check();
   homographies.Check();
   mosaic.Check();
   point_trust.Check();
@@ -181,6 +182,20 @@ void ColorLandmarks(const ThumbnailCache& thumbs,
   }
 }
 
+// The landmarks of segments from `first` on (confirmed plane hypotheses)
+// become their inliers.
+void AssignInliers(size_t first, const std::vector<PlaneSegment>& segments,
+                   std::vector<Landmark>* landmarks) {
+  std::unordered_map<FeatureId, int> plane_of;
+  for (size_t i = first; i < segments.size(); ++i) {
+    for (FeatureId id : segments[i].inlier_ids) plane_of[id] = segments[i].id;
+  }
+  for (Landmark& l : *landmarks) {
+    const auto it = plane_of.find(l.id);
+    if (it != plane_of.end()) l.plane_id = it->second;
+  }
+}
+
 // Stages 3 to 5: planes, image-to-plane homographies and texture mosaics.
 void SurfaceStages(const Dataset& dataset, const MappingOptions& options,
                    const Camera& camera,
@@ -196,9 +211,16 @@ void SurfaceStages(const Dataset& dataset, const MappingOptions& options,
   report.timings.push_back({"planes", timer.ElapsedSeconds()});
   timer.Restart();
   auto load_grey = [&](int frame) { return dataset.LoadImage(frame, false); };
+  std::vector<PlaneSegment> hypotheses;
+  if (options.growth.enabled && options.hypotheses.enabled) {
+    hypotheses = ProposePlaneHypotheses(options.hypotheses, options.planes,
+                                        landmarks, result->segments, centers);
+  }
+  const size_t fitted = result->segments.size();
   report.growth = GrowPlanePolygons(options.growth, camera, world_from_cam,
                                     landmarks, tracks, load_grey,
-                                    &result->segments);
+                                    &result->segments, hypotheses);
+  AssignInliers(fitted, result->segments, &landmarks);
   report.timings.push_back({"plane_growth", timer.ElapsedSeconds()});
   auto load_image = [&](int frame) { return dataset.LoadImage(frame, true); };
   timer.Restart();
@@ -366,7 +388,19 @@ nlohmann::json GrowthJson(const PlaneGrowthReport& growth) {
                       {"cells_plain", p.cells_plain},
                       {"cells_carved", p.cells_carved}});
   }
-  return {{"views", growth.views}, {"seconds", growth.seconds}, {"planes", planes}};
+  nlohmann::json hypotheses = nlohmann::json::array();
+  for (const HypothesisStats& h : growth.hypotheses) {
+    hypotheses.push_back({{"inliers", h.inliers},
+                          {"cells_textured", h.cells_textured},
+                          {"cells_inconsistent", h.cells_inconsistent},
+                          {"confirmed", h.confirmed},
+                          {"plane_id", h.plane_id},
+                          {"area_m2", h.area_m2}});
+  }
+  return {{"views", growth.views},
+          {"seconds", growth.seconds},
+          {"planes", planes},
+          {"hypotheses", hypotheses}};
 }
 
 nlohmann::json MosaicsJson(const MosaicReport& mosaic) {

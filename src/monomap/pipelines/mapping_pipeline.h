@@ -12,6 +12,7 @@
 #include "monomap/map/map.h"
 #include "monomap/planes/plane_fitting.h"
 #include "monomap/planes/plane_growth.h"
+#include "monomap/planes/plane_hypotheses.h"
 #include "monomap/texture/image_plane_homography.h"
 #include "monomap/texture/mosaic.h"
 #include "monomap/tracking/klt_tracker.h"
@@ -34,6 +35,9 @@ struct MappingOptions {
   // Stage 3b: plane polygons grown over the image regions their plane
   // explains.
   PlaneGrowthOptions growth;
+  // Stage 3c (with growth): planes along the scene's directions through
+  // landmarks on no plane, kept where the images confirm them.
+  PlaneHypothesisOptions hypotheses;
   // Stage 4: image-to-plane homographies.
   HomographyOptions homographies;
   // Stage 5: texture mosaics.

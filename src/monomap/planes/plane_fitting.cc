@@ -67,6 +67,60 @@ void PlaneFittingOptions::Check() const {
               "planes.merge_max_gap_m", "must be finite and >= 0");
 }
 
+double CovarianceBand(const Landmark& l, const Eigen::Vector3d& n, double k) {
+  const double var = n.dot(l.covariance_m2_per_px2 * n);
+  return std::isfinite(var) && var > 0 ? k * std::sqrt(var) : 0.0;
+}
+
+double LandmarkInlierThreshold(const PlaneFittingOptions& o,
+                               const Landmark& l) {
+  const double depth = l.mean_depth_m;
+  if (!std::isfinite(depth) || depth <= 0) return o.min_threshold_m;
+  return std::clamp(o.relative_threshold * depth, o.min_threshold_m,
+                    o.max_threshold_m);
+}
+
+void OrientPlane(const std::vector<Eigen::Vector3d>* camera_centers,
+                 Plane* plane) {
+  bool flip = plane->offset < 0;
+  if (camera_centers != nullptr && !camera_centers->empty()) {
+    int votes = 0;
+    double sum = 0.0;
+    for (const auto& c : *camera_centers) {
+      const double d = plane->SignedDistance(c);
+      votes += d > 0 ? 1 : (d < 0 ? -1 : 0);
+      sum += d;
+    }
+    flip = votes < 0 || (votes == 0 && sum < 0);
+  }
+  if (flip) {
+    plane->normal = -plane->normal;
+    plane->offset = -plane->offset;
+  }
+}
+
+void SetSegmentFrame(const std::vector<Eigen::Vector3d>& cpts,
+                     PlaneSegment* seg) {
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  for (const auto& p : cpts) c += p;
+  c /= static_cast<double>(cpts.size());
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  double sq = 0.0;
+  for (const auto& p : cpts) {
+    const double dist = seg->plane.SignedDistance(p);
+    sq += dist * dist;
+    const Eigen::Vector3d d = (p - c) - dist * seg->plane.normal;
+    scatter += d * d.transpose();
+  }
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(scatter);
+  Eigen::Vector3d u = eig.eigenvectors().col(2);
+  Eigen::Index big;
+  u.cwiseAbs().maxCoeff(&big);
+  if (u(big) < 0) u = -u;  // canonical sign: deterministic frames
+  seg->frame = MakePlaneFrame(seg->plane, c, u);
+  seg->rms_distance_m = std::sqrt(sq / cpts.size());
+}
+
 namespace {
 
 // Uniform hash grid over 2D points for fixed-radius neighbour queries.
@@ -244,13 +298,6 @@ Polygon2d MergedOutline(const std::vector<Polygon2d>& polygons,
   return poly.empty() ? ConvexHull(all) : poly;
 }
 
-// k * standard deviation of a landmark along unit normal n (0 if its
-// covariance is unknown).
-double CovarianceBand(const Landmark& l, const Eigen::Vector3d& n, double k) {
-  const double var = n.dot(l.covariance_m2_per_px2 * n);
-  return std::isfinite(var) && var > 0 ? k * std::sqrt(var) : 0.0;
-}
-
 uint64_t MixSeed(uint64_t seed, uint64_t k) {
   // splitmix64 step: decorrelates the seeds of successive RANSAC runs.
   uint64_t z = seed + 0x9e3779b97f4a7c15ULL * (k + 1);
@@ -294,11 +341,7 @@ void InitSearch(FitState* s) {
   for (int i = 0; i < n; ++i) {
     s->lms[i].plane_id = -1;
     if (!s->lms[i].x_in_world.allFinite()) continue;
-    const double depth = s->lms[i].mean_depth_m;
-    if (std::isfinite(depth) && depth > 0) {
-      s->thresholds[i] = std::clamp(o.relative_threshold * depth,
-                                    o.min_threshold_m, o.max_threshold_m);
-    }
+    s->thresholds[i] = LandmarkInlierThreshold(o, s->lms[i]);
     s->remaining.push_back(i);
   }
   s->min_count = static_cast<size_t>(
@@ -376,50 +419,6 @@ std::vector<std::vector<int>> SplitRegions(const FitState& s,
         s.options.max_connectivity_radius_m);
   }
   return ConnectedComponents(st, *radius);
-}
-
-// Orientation: towards the cameras, else towards the world origin.
-void OrientPlane(const std::vector<Eigen::Vector3d>* camera_centers,
-                 Plane* plane) {
-  bool flip = plane->offset < 0;
-  if (camera_centers != nullptr && !camera_centers->empty()) {
-    int votes = 0;
-    double sum = 0.0;
-    for (const auto& c : *camera_centers) {
-      const double d = plane->SignedDistance(c);
-      votes += d > 0 ? 1 : (d < 0 ? -1 : 0);
-      sum += d;
-    }
-    flip = votes < 0 || (votes == 0 && sum < 0);
-  }
-  if (flip) {
-    plane->normal = -plane->normal;
-    plane->offset = -plane->offset;
-  }
-}
-
-// Frame: centroid origin, u along the principal in-plane direction. Sets
-// seg->frame and seg->rms_distance_m from its points.
-void SetSegmentFrame(const std::vector<Eigen::Vector3d>& cpts,
-                     PlaneSegment* seg) {
-  Eigen::Vector3d c = Eigen::Vector3d::Zero();
-  for (const auto& p : cpts) c += p;
-  c /= static_cast<double>(cpts.size());
-  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
-  double sq = 0.0;
-  for (const auto& p : cpts) {
-    const double dist = seg->plane.SignedDistance(p);
-    sq += dist * dist;
-    const Eigen::Vector3d d = (p - c) - dist * seg->plane.normal;
-    scatter += d * d.transpose();
-  }
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(scatter);
-  Eigen::Vector3d u = eig.eigenvectors().col(2);
-  Eigen::Index big;
-  u.cwiseAbs().maxCoeff(&big);
-  if (u(big) < 0) u = -u;  // canonical sign: deterministic frames
-  seg->frame = MakePlaneFrame(seg->plane, c, u);
-  seg->rms_distance_m = std::sqrt(sq / cpts.size());
 }
 
 // Marks remaining outliers consistent with `seg` (within their uncertainty

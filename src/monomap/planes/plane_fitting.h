@@ -166,6 +166,28 @@ PlaneFittingReport FitPlanes(
     std::vector<PlaneSegment>* segments,
     const std::vector<Eigen::Vector3d>* camera_centers = nullptr);
 
+// Helpers FitPlanes shares with the stages that add segments
+// (plane_hypotheses.h).
+
+// Inlier threshold of a landmark (see PlaneFittingOptions::min_threshold_m).
+double LandmarkInlierThreshold(const PlaneFittingOptions& options,
+                               const Landmark& landmark);
+
+// k standard deviations of a landmark along unit normal n (0 if its
+// covariance is unknown).
+double CovarianceBand(const Landmark& landmark, const Eigen::Vector3d& n,
+                      double k);
+
+// Flips the plane to face most of `camera_centers`; without them (null or
+// empty) towards the world origin.
+void OrientPlane(const std::vector<Eigen::Vector3d>* camera_centers,
+                 Plane* plane);
+
+// Frame: centroid origin, u along the principal in-plane direction. Sets
+// seg->frame and seg->rms_distance_m from its points and seg->plane.
+void SetSegmentFrame(const std::vector<Eigen::Vector3d>& points,
+                     PlaneSegment* seg);
+
 // RANSAC estimator of a plane from 3 points whose residual is the distance
 // divided by each point's own threshold, so Ransac() runs with
 // inlier_threshold = 1.

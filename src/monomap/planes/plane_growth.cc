@@ -51,6 +51,13 @@ void PlaneGrowthOptions::Check() const {
   CheckOption(layer_cells >= 0, "growth.layer_cells", "must be >= 0");
   CheckOption(layer_max_angle_deg >= 0 && layer_max_angle_deg < 90,
               "growth.layer_max_angle_deg", "must be in [0, 90)");
+  CheckOption(hypothesis_min_textured_cells >= 1,
+              "growth.hypothesis_min_textured_cells", "must be >= 1");
+  CheckOption(hypothesis_min_textured_fraction >= 0 &&
+                  hypothesis_min_textured_fraction <= 1,
+              "growth.hypothesis_min_textured_fraction", "must be in [0, 1]");
+  CheckOption(hypothesis_min_ncc_gain >= 0, "growth.hypothesis_min_ncc_gain",
+              "must be >= 0");
   CheckOption(passes >= 1, "growth.passes", "must be >= 1");
 }
 
@@ -111,7 +118,10 @@ class CellJudge {
         occluders_(occluders),
         projector_(projector) {}
 
-  Evidence Judge(int r, int c) const {
+  // The cell's evidence; *ncc (if given) receives the median NCC of a
+  // textured cell (-1 otherwise).
+  Evidence Judge(int r, int c, double* ncc = nullptr) const {
+    if (ncc != nullptr) *ncc = -1.0;
     const int k = o_.samples_per_side;
     const int n = k * k;
     std::vector<float> patches;  // n values per seeing view
@@ -153,7 +163,7 @@ class CellJudge {
     if (nv < o_.min_views || MaxAngleDeg(rays) < o_.min_parallax_deg) {
       return Evidence::kNone;
     }
-    return Photometric(patches, rays, n);
+    return Photometric(patches, rays, n, ncc);
   }
 
  private:
@@ -172,8 +182,8 @@ class CellJudge {
   // plane shifts most there). Plain: the views' mean brightness against
   // their median.
   Evidence Photometric(const std::vector<float>& patches,
-                       const std::vector<Eigen::Vector3d>& rays,
-                       int n) const {
+                       const std::vector<Eigen::Vector3d>& rays, int n,
+                       double* median_ncc) const {
     const int nv = static_cast<int>(rays.size());
     std::vector<double> means(nv), stds(nv);
     for (int v = 0; v < nv; ++v) {
@@ -205,8 +215,9 @@ class CellJudge {
       const double denom = stds[v] * stds[w] * n;
       ncc[v] = denom > 0 ? cov / denom : 0.0;
     }
-    return Median(ncc) >= o_.min_ncc ? Evidence::kTextured
-                                     : Evidence::kInconsistent;
+    const double m = Median(ncc);
+    if (median_ncc != nullptr) *median_ncc = m;
+    return m >= o_.min_ncc ? Evidence::kTextured : Evidence::kInconsistent;
   }
 
   const PlaneGrowthOptions& o_;
@@ -304,35 +315,108 @@ bool MakeGrid(const PlaneSegment& seg, double cell, int reach, Grid* grid,
   return true;
 }
 
-// Cells that lie over a parallel plane's polygon, within layer_cells of
-// it: that plane's, not this one's to grow into.
-cv::Mat1b ClaimedByOthers(const PlaneGrowthOptions& o, const PlaneSegment& seg,
+// What growing a segment needs that does not change between passes: its
+// grid over the fitted polygon, the cells inside it, the carved cells.
+struct SegmentGrid {
+  bool ok = false;  // false: no view sees the polygon, or the grid is too big
+  Grid grid;
+  cv::Mat1b inside;
+  cv::Mat1i carved;
+};
+
+// Per cell, the index in `others` of the parallel plane whose polygon it
+// lies over, within layer_cells of it (-1: none): that plane's, not this
+// one's to grow into.
+cv::Mat1i ClaimedByOthers(const PlaneGrowthOptions& o, const PlaneSegment& seg,
                           const Grid& grid,
                           const std::vector<const PlaneSegment*>& others) {
-  cv::Mat1b claimed = cv::Mat1b::zeros(grid.rows, grid.cols);
+  cv::Mat1i owner(grid.rows, grid.cols, -1);
   const double cos_max = std::cos(DegToRad(o.layer_max_angle_deg));
   const double layer = o.layer_cells * grid.cell;
-  for (const PlaneSegment* b : others) {
+  for (size_t k = 0; k < others.size(); ++k) {
+    const PlaneSegment* b = others[k];
     if (std::abs(b->plane.normal.dot(seg.plane.normal)) < cos_max) continue;
     for (int r = 0; r < grid.rows; ++r) {
       for (int c = 0; c < grid.cols; ++c) {
         const Eigen::Vector3d x = seg.frame.ToWorld(grid.Centre(r, c));
-        if (std::abs(b->plane.SignedDistance(x)) <= layer &&
+        if (owner(r, c) < 0 && std::abs(b->plane.SignedDistance(x)) <= layer &&
             PointInPolygon(b->polygon, b->frame.ToPlane(x))) {
-          claimed(r, c) = 1;
+          owner(r, c) = static_cast<int>(k);
         }
       }
     }
   }
-  return claimed;
+  return owner;
 }
+
+// The segment moved along its normal onto `rival` (a parallel plane) at
+// its polygon's centroid: the same cells, seen as lying on the rival.
+PlaneSegment OntoRival(const PlaneSegment& seg, const PlaneSegment& rival) {
+  const Eigen::Vector3d c = seg.frame.ToWorld(PolygonCentroid(seg.polygon));
+  const double denom = rival.plane.normal.dot(seg.plane.normal);
+  const double shift = -rival.plane.SignedDistance(c) / denom;
+  PlaneSegment moved = seg;
+  moved.frame.origin += shift * seg.plane.normal;
+  moved.plane.offset -= shift;
+  return moved;
+}
+
+// What a cell of a segment's grid shows: free space (carved) gives no
+// evidence; a cell claimed by a parallel plane gives none for a fitted
+// segment, while a plane hypothesis (whose few landmarks may be a door leaf
+// recessed in its wall) must explain it clearly better than that plane
+// does: its NCC above the rival's by hypothesis_min_ncc_gain.
+class CellEvidence {
+ public:
+  CellEvidence(const PlaneGrowthOptions& o, const PlaneSegment& seg,
+               const SegmentGrid& g,
+               const std::vector<const PlaneSegment*>& occluders,
+               const std::vector<View>& views,
+               const DistortedProjector& projector, bool compete)
+      : o_(o),
+        g_(g),
+        judge_(o, seg, g.grid, views, occluders, projector),
+        owner_(ClaimedByOthers(o, seg, g.grid, occluders)) {
+    if (!compete) return;
+    rivals_.reserve(occluders.size());  // the judges keep references
+    for (const PlaneSegment* other : occluders) {
+      rivals_.push_back(OntoRival(seg, *other));
+    }
+    for (const PlaneSegment& rival : rivals_) {
+      rival_judges_.emplace_back(o, rival, g.grid, views, occluders, projector);
+    }
+  }
+
+  Evidence operator()(int r, int c) const {
+    if (g_.carved(r, c) >= o_.min_carving_landmarks) return Evidence::kNone;
+    const int owner = owner_(r, c);
+    if (owner < 0) return judge_.Judge(r, c);
+    if (rival_judges_.empty()) return Evidence::kNone;
+    double ncc = -1.0, rival_ncc = -1.0;
+    const Evidence e = judge_.Judge(r, c, &ncc);
+    if (e != Evidence::kTextured && e != Evidence::kInconsistent) {
+      return Evidence::kNone;  // plain: no plane wins
+    }
+    rival_judges_[owner].Judge(r, c, &rival_ncc);
+    return e == Evidence::kTextured && ncc >= rival_ncc + o_.hypothesis_min_ncc_gain
+               ? Evidence::kTextured
+               : Evidence::kInconsistent;
+  }
+
+ private:
+  const PlaneGrowthOptions& o_;
+  const SegmentGrid& g_;
+  const CellJudge judge_;
+  const cv::Mat1i owner_;
+  std::vector<PlaneSegment> rivals_;
+  std::vector<CellJudge> rival_judges_;
+};
 
 // Breadth-first growth from the inside cells, a ring of neighbours at a
 // time (judged in parallel). run(r, c): cells since the last texture
 // evidence; plain cells join only while it stays within max_plain_run.
 cv::Mat1b Grow(const PlaneGrowthOptions& o, const Grid& grid,
-               const cv::Mat1b& inside, const cv::Mat1i& carved,
-               const cv::Mat1b& claimed, const CellJudge& judge,
+               const cv::Mat1b& inside, const CellEvidence& judge,
                PlaneGrowthStats* stats, cv::Mat1b* proof) {
   cv::Mat1b member = inside.clone();
   *proof = inside.clone();
@@ -358,9 +442,7 @@ cv::Mat1b Grow(const PlaneGrowthOptions& o, const Grid& grid,
     std::vector<Evidence> evidence(candidates.size(), Evidence::kNone);
     tbb::parallel_for(size_t{0}, candidates.size(), [&](size_t i) {
       const cv::Point& p = candidates[i];
-      if (carved(p.y, p.x) < o.min_carving_landmarks && !claimed(p.y, p.x)) {
-        evidence[i] = judge.Judge(p.y, p.x);
-      }
+      evidence[i] = judge(p.y, p.x);
     });
     frontier.clear();
     for (size_t i = 0; i < candidates.size(); ++i) {
@@ -388,15 +470,6 @@ cv::Mat1b Grow(const PlaneGrowthOptions& o, const Grid& grid,
   }
   return member;
 }
-
-// What growing a segment needs that does not change between passes: its
-// grid over the fitted polygon, the cells inside it, the carved cells.
-struct SegmentGrid {
-  bool ok = false;  // false: no view sees the polygon, or the grid is too big
-  Grid grid;
-  cv::Mat1b inside;
-  cv::Mat1i carved;
-};
 
 SegmentGrid PrepareGrid(const PlaneGrowthOptions& o, const PlaneSegment& seg,
                         const std::vector<View>& views,
@@ -444,25 +517,72 @@ void KeepPlainBetweenProofs(const cv::Mat1b& proof, cv::Mat1b* member,
   }
 }
 
+// The cells over a hypothesis' landmarks that the images confirm: kept
+// in *inside when textured or plain; textured ones counted in *h. False
+// when too few textured cells correlate across the views, or too many do
+// not: then it is no plane of the scene.
+bool ConfirmInside(const PlaneGrowthOptions& o, const CellEvidence& judge,
+                   cv::Mat1b* inside, cv::Mat1b* plain, HypothesisStats* h) {
+  std::vector<cv::Point> cells;
+  for (int r = 0; r < inside->rows; ++r) {
+    for (int c = 0; c < inside->cols; ++c) {
+      if ((*inside)(r, c)) cells.emplace_back(c, r);
+    }
+  }
+  std::vector<Evidence> evidence(cells.size(), Evidence::kNone);
+  tbb::parallel_for(size_t{0}, cells.size(), [&](size_t i) {
+    evidence[i] = judge(cells[i].y, cells[i].x);
+  });
+  *plain = cv::Mat1b::zeros(inside->size());
+  for (size_t i = 0; i < cells.size(); ++i) {
+    const cv::Point& p = cells[i];
+    h->cells_textured += evidence[i] == Evidence::kTextured;
+    h->cells_inconsistent += evidence[i] == Evidence::kInconsistent;
+    if (evidence[i] == Evidence::kPlain) (*plain)(p.y, p.x) = 1;
+    if (evidence[i] != Evidence::kTextured && evidence[i] != Evidence::kPlain) {
+      (*inside)(p.y, p.x) = 0;
+    }
+  }
+  return h->cells_textured >= o.hypothesis_min_textured_cells &&
+         h->cells_textured >= o.hypothesis_min_textured_fraction *
+                                  (h->cells_textured + h->cells_inconsistent);
+}
+
 // Grows one segment (its fitted polygon) against the others (occluders).
-// Returns the new polygon, or the fitted one if nothing grew.
+// Returns the new polygon, or the fitted one if nothing grew. With
+// `hypothesis`, the segment is a plane hypothesis: only the cells of its
+// polygon that the images confirm start the growth, and an empty polygon
+// is returned when they do not confirm it.
 Polygon2d GrowSegment(const PlaneGrowthOptions& o, const PlaneSegment& seg,
                       const SegmentGrid& g,
                       const std::vector<const PlaneSegment*>& occluders,
                       const std::vector<View>& views,
                       const DistortedProjector& projector,
-                      PlaneGrowthStats* stats) {
-  if (!g.ok) return seg.polygon;
+                      PlaneGrowthStats* stats,
+                      HypothesisStats* hypothesis = nullptr) {
+  if (!g.ok) return hypothesis ? Polygon2d{} : seg.polygon;
   const Grid& grid = g.grid;
   stats->cell_m = grid.cell;
   stats->cells_carved = cv::countNonZero(g.carved >= o.min_carving_landmarks);
-  const CellJudge judge(o, seg, grid, views, occluders, projector);
-  const cv::Mat1b claimed = ClaimedByOthers(o, seg, grid, occluders);
+  const CellEvidence judge(o, seg, g, occluders, views, projector,
+                           /*compete=*/hypothesis != nullptr);
+  cv::Mat1b inside = g.inside.clone(), plain_inside;
+  if (hypothesis != nullptr &&
+      !ConfirmInside(o, judge, &inside, &plain_inside, hypothesis)) {
+    return {};
+  }
+  if (hypothesis != nullptr) {
+    stats->cells_textured += hypothesis->cells_textured;
+    stats->cells_plain += cv::countNonZero(plain_inside);
+  }
   cv::Mat1b proof;
   cv::Mat1b member =
-      Grow(o, grid, g.inside, g.carved, claimed, judge, stats, &proof);
+      Grow(o, grid, inside, judge, stats, &proof);
+  // A hypothesis' plain cells prove nothing either.
+  if (hypothesis != nullptr) proof.setTo(0, plain_inside);
   if (o.plain_between_proofs) KeepPlainBetweenProofs(proof, &member, stats);
-  if (stats->cells_textured + stats->cells_plain == 0) return seg.polygon;
+  const bool grew = stats->cells_textured + stats->cells_plain > 0;
+  if (!grew && hypothesis == nullptr) return seg.polygon;
   member *= 255;
   if (o.close_cells > 0) {
     const int k = 2 * o.close_cells + 1;
@@ -470,6 +590,7 @@ Polygon2d GrowSegment(const PlaneGrowthOptions& o, const PlaneSegment& seg,
                      cv::getStructuringElement(cv::MORPH_RECT, {k, k}));
   }
   Polygon2d poly = OutlineOfCells(member, grid.lo, grid.cell, 0);
+  if (hypothesis != nullptr) return poly.size() >= 3 ? poly : Polygon2d{};
   return poly.size() >= 3 ? poly : seg.polygon;
 }
 
@@ -499,13 +620,60 @@ std::vector<View> LoadViews(const PlaneGrowthOptions& o, const Camera& camera,
   return views;
 }
 
+// Checks the hypotheses against the images, most landmarks first (see
+// GrowPlanePolygons); confirmed ones join *segments and hide what lies
+// behind them from the next.
+void ConfirmHypotheses(
+    const PlaneGrowthOptions& o, const std::vector<View>& views,
+    const DistortedProjector& projector,
+    const std::vector<Rigid3d>& world_from_cam,
+    const std::vector<Landmark>& landmarks,
+    const std::unordered_map<FeatureId, const Track*>& track_by_id,
+    const std::vector<PlaneSegment>& hypotheses,
+    std::vector<PlaneSegment>* segments, PlaneGrowthReport* report) {
+  std::vector<int> order(hypotheses.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+    return hypotheses[a].inlier_ids.size() > hypotheses[b].inlier_ids.size();
+  });
+  for (int i : order) {
+    PlaneSegment seg = hypotheses[i];
+    HypothesisStats h;
+    h.inliers = static_cast<int>(seg.inlier_ids.size());
+    const SegmentGrid g = PrepareGrid(o, seg, views, projector,
+                                      world_from_cam, landmarks, track_by_id);
+    std::vector<const PlaneSegment*> occluders;
+    for (const PlaneSegment& other : *segments) {
+      if (other.polygon.size() >= 3) occluders.push_back(&other);
+    }
+    PlaneGrowthStats stats;
+    stats.area_before_m2 = std::abs(PolygonArea(seg.polygon));
+    const Polygon2d grown =
+        GrowSegment(o, seg, g, occluders, views, projector, &stats, &h);
+    h.confirmed = grown.size() >= 3;
+    if (h.confirmed) {
+      seg.id = static_cast<int>(segments->size());
+      seg.landmark_polygon = seg.polygon;
+      seg.polygon = grown;
+      h.plane_id = seg.id;
+      h.area_m2 = std::abs(PolygonArea(grown));
+      stats.plane_id = seg.id;
+      stats.area_after_m2 = h.area_m2;
+      report->planes.push_back(stats);
+      segments->push_back(std::move(seg));
+    }
+    report->hypotheses.push_back(h);
+  }
+}
+
 }  // namespace
 
 PlaneGrowthReport GrowPlanePolygons(
     const PlaneGrowthOptions& options, const Camera& camera,
     const std::vector<Rigid3d>& world_from_cam,
     const std::vector<Landmark>& landmarks, const std::vector<Track>& tracks,
-    const GreyImageLoader& load_grey, std::vector<PlaneSegment>* segments) {
+    const GreyImageLoader& load_grey, std::vector<PlaneSegment>* segments,
+    const std::vector<PlaneSegment>& hypotheses) {
   options.Check();
   Timer timer;
   PlaneGrowthReport report;
@@ -563,6 +731,8 @@ PlaneGrowthReport GrowPlanePolygons(
     seg.landmark_polygon.clear();
     if (seg.polygon != original[i]) seg.landmark_polygon = original[i];
   }
+  ConfirmHypotheses(options, views, projector, world_from_cam, landmarks,
+                    track_by_id, hypotheses, segments, &report);
   report.seconds = timer.ElapsedSeconds();
   return report;
 }

@@ -91,6 +91,16 @@ struct PlaneGrowthOptions {
   double layer_max_angle_deg = 10.0;
   // Holes and notches up to this many cells are closed in the outline.
   int close_cells = 1;
+  // A plane hypothesis (plane_hypotheses.h) is kept when at least this
+  // many cells over its landmarks' hull correlate across the views ...
+  int hypothesis_min_textured_cells = 4;
+  // ... and they are at least this share of the cells there whose texture
+  // was judged (correlating or not): a plane through clutter or a few cm
+  // off the surface misregisters the views.
+  double hypothesis_min_textured_fraction = 0.6;
+  // A hypothesis' cell over a parallel plane's polygon (see layer_cells)
+  // is its own only if its NCC beats that plane's by this much.
+  double hypothesis_min_ncc_gain = 0.05;
   // Growth passes: each regrows every segment from its fitted polygon,
   // hidden by the others as the previous pass grew them (a wall below a
   // floor that had not grown yet).
@@ -110,8 +120,19 @@ struct PlaneGrowthStats {
   int cells_carved = 0;    // free space by landmark rays (of the grid)
 };
 
+// One plane hypothesis' check against the images.
+struct HypothesisStats {
+  int inliers = 0;             // its landmarks
+  int cells_textured = 0;      // over its hull, correlating across the views
+  int cells_inconsistent = 0;  // ... judged but not correlating
+  bool confirmed = false;      // kept as a segment
+  int plane_id = -1;           // its segment id if confirmed
+  double area_m2 = 0.0;        // its polygon after growth if confirmed
+};
+
 struct PlaneGrowthReport {
-  std::vector<PlaneGrowthStats> planes;
+  std::vector<PlaneGrowthStats> planes;  // the segments', then hypotheses'
+  std::vector<HypothesisStats> hypotheses;
   int views = 0;  // frames used as views
   double seconds = 0.0;
 };
@@ -123,12 +144,18 @@ using GreyImageLoader = std::function<cv::Mat(int frame)>;
 // Grows every segment's polygon over the cells its plane explains (see the
 // top of this file), the largest segment first: a grown plane then hides
 // what lies behind it from the next. Planes and inliers are unchanged.
+// Then checks each of `hypotheses` (plane_hypotheses.h; ids following the
+// segments'), most landmarks first: the cells over its landmarks' hull
+// must correlate across the views (hypothesis_min_textured_*); a confirmed
+// one grows from the confirmed cells like a segment and is appended to
+// *segments, renumbered to follow them, its hull as landmark_polygon.
 // Throws OptionsError for bad options and InputError for an image that is
 // empty or not of the camera's size.
 PlaneGrowthReport GrowPlanePolygons(
     const PlaneGrowthOptions& options, const Camera& camera,
     const std::vector<Rigid3d>& world_from_cam,
     const std::vector<Landmark>& landmarks, const std::vector<Track>& tracks,
-    const GreyImageLoader& load_grey, std::vector<PlaneSegment>* segments);
+    const GreyImageLoader& load_grey, std::vector<PlaneSegment>* segments,
+    const std::vector<PlaneSegment>& hypotheses = {});
 
 }  // namespace monomap

@@ -110,6 +110,94 @@ TEST(PlaneGrowth, AWrongPlaneDoesNotGrow) {
   EXPECT_LT(report.planes[0].area_after_m2, 0.2);
 }
 
+// A plane hypothesis (plane_hypotheses.h) of 8 landmarks over the patch.
+PlaneSegment Hypothesis(const TestScene& scene, double offset_m) {
+  PlaneSegment h = FrontWallPatch(scene, offset_m);
+  h.id = 1;
+  for (FeatureId id = 100; id < 108; ++id) h.inlier_ids.push_back(id);
+  return h;
+}
+
+// A fitted segment: the back wall, which no view sees (it does not grow).
+std::vector<PlaneSegment> BackWall(const TestScene& scene) {
+  const TexturedPlane& wall = scene.map.planes[2];
+  PlaneSegment seg;
+  seg.plane = wall.plane;
+  seg.frame = wall.frame;
+  seg.polygon = wall.polygon;
+  return {seg};
+}
+
+TEST(PlaneGrowth, AHypothesisTheImagesConfirmJoinsAndGrows) {
+  const TestScene scene = Room();
+  std::vector<PlaneSegment> segments = BackWall(scene);
+  const PlaneGrowthReport report =
+      GrowPlanePolygons(GrowthOn(), scene.camera, scene.world_from_cam, {}, {},
+                        Loader(scene), &segments, {Hypothesis(scene, 0.0)});
+  ASSERT_EQ(report.hypotheses.size(), 1u);
+  const HypothesisStats& h = report.hypotheses[0];
+  EXPECT_TRUE(h.confirmed);
+  EXPECT_EQ(h.inliers, 8);
+  // The 0.4 x 0.3 m patch holds 12 cells of about 10 cm here (12 image
+  // pixels at 2-3 m): all of them correlate.
+  EXPECT_GE(h.cells_textured, 11);
+  EXPECT_LE(h.cells_inconsistent, 1);
+  ASSERT_EQ(segments.size(), 2u);
+  EXPECT_EQ(segments[1].id, 1);
+  EXPECT_EQ(h.plane_id, 1);
+  EXPECT_GT(h.area_m2, 1.2);  // as a fitted patch grows
+  const double c = report.planes.back().cell_m;
+  EXPECT_GT(ShareInside(segments[1].polygon, -c, 3 + c, -c, 1.2 + c), 0.97);
+  EXPECT_NEAR(std::abs(PolygonArea(segments[1].landmark_polygon)), 0.12, 1e-9);
+}
+
+TEST(PlaneGrowth, AHypothesisOffTheSurfaceIsNotConfirmed) {
+  const TestScene scene = Room();
+  std::vector<PlaneSegment> segments = BackWall(scene);
+  const PlaneGrowthReport report =
+      GrowPlanePolygons(GrowthOn(), scene.camera, scene.world_from_cam, {}, {},
+                        Loader(scene), &segments, {Hypothesis(scene, 0.2)});
+  ASSERT_EQ(report.hypotheses.size(), 1u);
+  EXPECT_FALSE(report.hypotheses[0].confirmed);
+  EXPECT_EQ(report.hypotheses[0].plane_id, -1);
+  EXPECT_GE(report.hypotheses[0].cells_inconsistent, 11);  // of 12
+  EXPECT_LE(report.hypotheses[0].cells_textured, 1);
+  EXPECT_EQ(segments.size(), 1u);
+}
+
+// The whole front wall as a fitted segment, `offset_m` towards the
+// cameras.
+PlaneSegment FrontWall(const TestScene& scene, double offset_m) {
+  PlaneSegment seg = FrontWallPatch(scene, offset_m);
+  seg.polygon = scene.map.planes[1].polygon;
+  return seg;
+}
+
+TEST(PlaneGrowth, AHypothesisOverAParallelPlaneMustExplainTheImagesBetter) {
+  const TestScene scene = Room();
+  // The fitted wall is right: a hypothesis 20 cm in front of it, over its
+  // polygon (within layer_cells), loses every cell to it.
+  std::vector<PlaneSegment> segments = {FrontWall(scene, 0.0)};
+  PlaneGrowthReport report =
+      GrowPlanePolygons(GrowthOn(), scene.camera, scene.world_from_cam, {}, {},
+                        Loader(scene), &segments, {Hypothesis(scene, 0.2)});
+  ASSERT_EQ(report.hypotheses.size(), 1u);
+  EXPECT_FALSE(report.hypotheses[0].confirmed);
+  EXPECT_GE(report.hypotheses[0].cells_inconsistent, 11);
+  EXPECT_EQ(segments.size(), 1u);
+  // The fitted plane is 20 cm off (behind the wall, so that it hides
+  // nothing): the true one, hypothesized from a few landmarks, wins the
+  // cells.
+  segments = {FrontWall(scene, -0.2)};
+  report =
+      GrowPlanePolygons(GrowthOn(), scene.camera, scene.world_from_cam, {}, {},
+                        Loader(scene), &segments, {Hypothesis(scene, 0.0)});
+  ASSERT_EQ(report.hypotheses.size(), 1u);
+  EXPECT_TRUE(report.hypotheses[0].confirmed);
+  EXPECT_GE(report.hypotheses[0].cells_textured, 11);
+  EXPECT_EQ(segments.size(), 2u);
+}
+
 TEST(PlaneGrowth, PlainCellsOnlyBridgeAndLandmarksBehindCarveFreeSpace) {
   TestScene scene = Room();
   // Flat grey images: every cell is plain and consistent. By default plain
