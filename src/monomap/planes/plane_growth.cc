@@ -354,8 +354,11 @@ cv::Mat1i ClaimedByOthers(const PlaneGrowthOptions& o, const PlaneSegment& seg,
 PlaneSegment OntoRival(const PlaneSegment& seg, const PlaneSegment& rival) {
   const Eigen::Vector3d c = seg.frame.ToWorld(PolygonCentroid(seg.polygon));
   const double denom = rival.plane.normal.dot(seg.plane.normal);
-  const double shift = -rival.plane.SignedDistance(c) / denom;
   PlaneSegment moved = seg;
+  // Only parallel planes claim cells; a plane across this one is never
+  // asked, and is left where it is rather than sent to infinity.
+  if (std::abs(denom) < 0.1) return moved;
+  const double shift = -rival.plane.SignedDistance(c) / denom;
   moved.frame.origin += shift * seg.plane.normal;
   moved.plane.offset -= shift;
   return moved;
