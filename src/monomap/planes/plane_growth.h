@@ -19,6 +19,11 @@
 // that lie behind the plane is empty (the views looked through it). And a
 // cell over a parallel plane's polygon, a few cells from it, is that
 // plane's: photo-consistency cannot tell a keyboard's plane from its desk's.
+//
+// The same photometric test checks plane hypotheses (plane_hypotheses.h),
+// planes that a few landmarks suggest: one becomes a segment only where
+// the images confirm it, and over a parallel plane's polygon only where it
+// explains the images clearly better than that plane.
 #pragma once
 
 #include <functional>
