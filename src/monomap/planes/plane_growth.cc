@@ -349,16 +349,16 @@ cv::Mat1i ClaimedByOthers(const PlaneGrowthOptions& o, const PlaneSegment& seg,
   return owner;
 }
 
-// The segment moved along its normal onto `rival` (a parallel plane) at
-// its polygon's centroid: the same cells, seen as lying on the rival.
+// The segment's plane and frame moved along its normal onto `rival` (a
+// parallel plane: ClaimedByOthers) at its polygon's centroid: the same
+// cells, seen as lying on the rival.
 PlaneSegment OntoRival(const PlaneSegment& seg, const PlaneSegment& rival) {
   const Eigen::Vector3d c = seg.frame.ToWorld(PolygonCentroid(seg.polygon));
-  const double denom = rival.plane.normal.dot(seg.plane.normal);
-  PlaneSegment moved = seg;
-  // Only parallel planes claim cells; a plane across this one is never
-  // asked, and is left where it is rather than sent to infinity.
-  if (std::abs(denom) < 0.1) return moved;
-  const double shift = -rival.plane.SignedDistance(c) / denom;
+  const double shift = -rival.plane.SignedDistance(c) /
+                       rival.plane.normal.dot(seg.plane.normal);
+  PlaneSegment moved;
+  moved.plane = seg.plane;
+  moved.frame = seg.frame;
   moved.frame.origin += shift * seg.plane.normal;
   moved.plane.offset -= shift;
   return moved;
@@ -381,10 +381,19 @@ class CellEvidence {
         judge_(o, seg, g.grid, views, occluders, projector),
         owner_(ClaimedByOthers(o, seg, g.grid, occluders)) {
     if (!compete) return;
-    rivals_.reserve(occluders.size());  // the judges keep references
-    for (const PlaneSegment* other : occluders) {
-      rivals_.push_back(OntoRival(seg, *other));
+    // A judge for each occluder that claims cells, at its place along the
+    // normal.
+    rival_of_.assign(occluders.size(), -1);
+    for (int r = 0; r < owner_.rows; ++r) {
+      for (int c = 0; c < owner_.cols; ++c) {
+        const int k = owner_(r, c);
+        if (k >= 0 && rival_of_[k] < 0) {
+          rival_of_[k] = static_cast<int>(rivals_.size());
+          rivals_.push_back(OntoRival(seg, *occluders[k]));
+        }
+      }
     }
+    rival_judges_.reserve(rivals_.size());  // rivals_ no longer moves
     for (const PlaneSegment& rival : rivals_) {
       rival_judges_.emplace_back(o, rival, g.grid, views, occluders, projector);
     }
@@ -397,11 +406,10 @@ class CellEvidence {
     if (rival_judges_.empty()) return Evidence::kNone;
     double ncc = -1.0, rival_ncc = -1.0;
     const Evidence e = judge_.Judge(r, c, &ncc);
-    if (e != Evidence::kTextured && e != Evidence::kInconsistent) {
-      return Evidence::kNone;  // plain: no plane wins
-    }
-    rival_judges_[owner].Judge(r, c, &rival_ncc);
-    return e == Evidence::kTextured && ncc >= rival_ncc + o_.hypothesis_min_ncc_gain
+    if (e == Evidence::kPlain) return Evidence::kNone;  // no plane wins
+    if (e != Evidence::kTextured) return e;
+    rival_judges_[rival_of_[owner]].Judge(r, c, &rival_ncc);
+    return ncc >= rival_ncc + o_.hypothesis_min_ncc_gain
                ? Evidence::kTextured
                : Evidence::kInconsistent;
   }
@@ -411,6 +419,7 @@ class CellEvidence {
   const SegmentGrid& g_;
   const CellJudge judge_;
   const cv::Mat1i owner_;
+  std::vector<int> rival_of_;  // per occluder: index in rivals_, or -1
   std::vector<PlaneSegment> rivals_;
   std::vector<CellJudge> rival_judges_;
 };
