@@ -233,6 +233,7 @@ AreaCoverage MeasureAreaCoverage(const Map& map, const Map& truth,
     MapPlaneOnTruth(p, truth, truth_from_map, options, &area, &on);
     result.map_area_m2 += area;
     result.map_area_on_truth_m2 += on;
+    result.map_planes.push_back({p.id, area, on});
   }
   if (result.map_area_m2 > 0) {
     result.area_precision = result.map_area_on_truth_m2 / result.map_area_m2;

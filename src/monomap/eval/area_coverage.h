@@ -49,6 +49,14 @@ struct PlaneCoverage {
   double recovered_observable_area_m2 = 0.0;  // part of the recovered area
 };
 
+// One map plane's area and how much of it lies on the truth: where a map
+// puts area off any surface.
+struct MapPlaneCoverage {
+  int map_id = 0;
+  double area_m2 = 0.0;
+  double on_truth_m2 = 0.0;
+};
+
 struct AreaCoverage {
   double seen_area_m2 = 0.0;
   double recovered_area_m2 = 0.0;
@@ -73,6 +81,7 @@ struct AreaCoverage {
   double map_area_on_truth_m2 = 0.0;
   // map_area_on_truth_m2 / map_area_m2 (0 when the map has no area).
   double area_precision = 0.0;
+  std::vector<MapPlaneCoverage> map_planes;  // in the map's order
 };
 
 // Coverage of `truth`'s planes by `map`'s planes, seen from map.trajectory

@@ -116,6 +116,11 @@ TEST(AreaCoverage, MapAreaBeyondTheTruePolygonIsNotOnTheTruth) {
   EXPECT_NEAR(c.map_area_m2, 2.0, 0.02);
   EXPECT_NEAR(c.map_area_on_truth_m2, 1.0, 0.02);
   EXPECT_NEAR(c.area_precision, 0.5, 0.01);
+  // ... and per map plane.
+  ASSERT_EQ(c.map_planes.size(), 1u);
+  EXPECT_EQ(c.map_planes[0].map_id, 0);
+  EXPECT_NEAR(c.map_planes[0].area_m2, 2.0, 0.02);
+  EXPECT_NEAR(c.map_planes[0].on_truth_m2, 1.0, 0.02);
 }
 
 TEST(AreaCoverage, ObservableAreaNeedsTwoViewsApartAndNotGrazing) {

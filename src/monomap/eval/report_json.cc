@@ -70,6 +70,12 @@ nlohmann::json ToJson(const StructureAccuracy& a) {
                            {"recovered_observable_area_m2",
                             p.recovered_observable_area_m2}});
   }
+  nlohmann::json map_planes = nlohmann::json::array();
+  for (const MapPlaneCoverage& p : c.map_planes) {
+    map_planes.push_back({{"map_id", p.map_id},
+                          {"area_m2", p.area_m2},
+                          {"on_truth_m2", p.on_truth_m2}});
+  }
   j["area"] = {{"seen_area_m2", c.seen_area_m2},
                {"recovered_area_m2", c.recovered_area_m2},
                {"area_recall", c.area_recall},
@@ -84,7 +90,8 @@ nlohmann::json ToJson(const StructureAccuracy& a) {
                {"large_planes_observable", c.large_planes_observable},
                {"large_planes_observable_recovered",
                 c.large_planes_observable_recovered},
-               {"planes", area_planes}};
+               {"planes", area_planes},
+               {"map_planes", map_planes}};
   return j;
 }
 

@@ -188,6 +188,15 @@ void AddGrowthOptions(CLI::App* cmd, BuildArgs* a) {
                   "cells outside its polygon")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
+  cmd->add_flag("!--plane-growth-no-aperture-test", o.growth.aperture_test,
+                "Count a textured cell as evidence even when its texture does "
+                "not change along the direction the views' parallax moves it");
+  cmd->add_option("--plane-growth-aperture-ratio",
+                  o.growth.aperture_max_ratio,
+                  "A textured cell is evidence only if its patch changes at "
+                  "least this much along the parallax as across it")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
 }
 
 void AddMappingOptions(CLI::App* cmd, BuildArgs* a) {

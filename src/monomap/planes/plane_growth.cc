@@ -59,6 +59,10 @@ void PlaneGrowthOptions::Check() const {
   CheckOption(hypothesis_min_ncc_gain >= 0, "growth.hypothesis_min_ncc_gain",
               "must be >= 0");
   CheckOption(passes >= 1, "growth.passes", "must be >= 1");
+  CheckOption(aperture_shift_samples > 0 && std::isfinite(aperture_shift_samples),
+              "growth.aperture_shift_samples", "must be positive");
+  CheckOption(aperture_max_ratio >= 0 && aperture_max_ratio <= 1,
+              "growth.aperture_max_ratio", "must be in [0, 1]");
 }
 
 namespace {
@@ -122,12 +126,11 @@ class CellJudge {
   // textured cell (-1 otherwise).
   Evidence Judge(int r, int c, double* ncc = nullptr) const {
     if (ncc != nullptr) *ncc = -1.0;
-    const int k = o_.samples_per_side;
-    const int n = k * k;
+    const int n = o_.samples_per_side * o_.samples_per_side;
     std::vector<float> patches;  // n values per seeing view
     std::vector<Eigen::Vector3d> rays;
+    std::vector<const View*> seeing;
     const Eigen::Vector3d centre = seg_.frame.ToWorld(grid_.Centre(r, c));
-    const Camera& camera = projector_.camera();
     for (const View& v : views_) {
       const Eigen::Vector3d ray = centre - v.centre;
       const double dist = ray.norm();
@@ -138,35 +141,123 @@ class CellJudge {
                  o_.occluder_dilation_cells * grid_.cell)) {
         continue;
       }
-      const size_t start = patches.size();
-      bool ok = true;
-      for (int i = 0; i < n && ok; ++i) {
-        const Eigen::Vector2d st =
-            grid_.lo + grid_.cell * Eigen::Vector2d(c + (i % k + 0.5) / k,
-                                                    r + (i / k + 0.5) / k);
-        Eigen::Vector2d px;
-        ok = projector_.Project(v.cam_from_world * seg_.frame.ToWorld(st),
-                                &px) &&
-             camera.InImage(px, 1.0);
-        if (ok) {
-          patches.push_back(SampleGreyBilinear(
-              v.grey, static_cast<float>(px.x()), static_cast<float>(px.y())));
-        }
-      }
-      if (!ok) {
-        patches.resize(start);
-        continue;
-      }
+      if (!Sample(v, r, c, Eigen::Vector2d::Zero(), &patches)) continue;
       rays.push_back(ray / dist);
+      seeing.push_back(&v);
     }
     const int nv = static_cast<int>(rays.size());
     if (nv < o_.min_views || MaxAngleDeg(rays) < o_.min_parallax_deg) {
       return Evidence::kNone;
     }
-    return Photometric(patches, rays, n, ncc);
+    const Evidence e = Photometric(patches, rays, n, ncc);
+    if (e == Evidence::kTextured && o_.aperture_test &&
+        AlongParallaxOnly(r, c, seeing, rays, patches)) {
+      if (ncc != nullptr) *ncc = -1.0;
+      return Evidence::kNone;
+    }
+    return e;
   }
 
  private:
+  // Appends view v's samples of cell (r, c), moved by `shift` (plane
+  // coordinates, m); false (nothing appended) if one falls outside the
+  // image.
+  bool Sample(const View& v, int r, int c, const Eigen::Vector2d& shift,
+              std::vector<float>* patch) const {
+    const int k = o_.samples_per_side;
+    const size_t start = patch->size();
+    for (int i = 0; i < k * k; ++i) {
+      const Eigen::Vector2d st =
+          grid_.lo + shift +
+          grid_.cell * Eigen::Vector2d(c + (i % k + 0.5) / k,
+                                       r + (i / k + 0.5) / k);
+      Eigen::Vector2d px;
+      if (!projector_.Project(v.cam_from_world * seg_.frame.ToWorld(st),
+                              &px) ||
+          !projector_.camera().InImage(px, 1.0)) {
+        patch->resize(start);
+        return false;
+      }
+      patch->push_back(SampleGreyBilinear(
+          v.grey, static_cast<float>(px.x()), static_cast<float>(px.y())));
+    }
+    return true;
+  }
+
+  // The aperture problem: a surface off the plane misregisters the views
+  // along one direction of the plane only (where the rays of the two views
+  // of most parallax through a point off it meet the plane). A texture
+  // that hardly changes along it (an edge along the direction of travel: a
+  // skirting board, a wall's foot seen along a corridor) correlates across
+  // the views whatever the plane, so its NCC proves nothing. True when, in
+  // most views, the patch moved along that direction decorrelates less than
+  // aperture_max_ratio times as much as moved across it (1 - NCC grows
+  // with the texture's gradient energy in the direction moved).
+  bool AlongParallaxOnly(int r, int c, const std::vector<const View*>& seeing,
+                         const std::vector<Eigen::Vector3d>& rays,
+                         const std::vector<float>& patches) const {
+    size_t a = 0, b = 0;
+    double min_cos = 2.0;
+    for (size_t i = 0; i < rays.size(); ++i) {
+      for (size_t j = i + 1; j < rays.size(); ++j) {
+        if (rays[i].dot(rays[j]) < min_cos) {
+          min_cos = rays[i].dot(rays[j]);
+          a = i;
+          b = j;
+        }
+      }
+    }
+    // A point a cell off the plane, seen from views a and b, meets the
+    // plane at two places: their difference is the misregistration.
+    const Eigen::Vector3d off = seg_.frame.ToWorld(grid_.Centre(r, c)) +
+                                grid_.cell * seg_.plane.normal;
+    const Eigen::Vector2d d = OnPlane(seeing[a]->centre, off) -
+                              OnPlane(seeing[b]->centre, off);
+    if (d.norm() < 1e-12) return true;
+    const int n = o_.samples_per_side * o_.samples_per_side;
+    const Eigen::Vector2d along = o_.aperture_shift_samples * grid_.cell /
+                                  o_.samples_per_side * d.normalized();
+    const Eigen::Vector2d across(-along.y(), along.x());
+    std::vector<double> ratio;
+    for (size_t v = 0; v < seeing.size(); ++v) {
+      std::vector<float> moved_along, moved_across;
+      if (!Sample(*seeing[v], r, c, along, &moved_along) ||
+          !Sample(*seeing[v], r, c, across, &moved_across)) {
+        continue;
+      }
+      const float* p = patches.data() + v * n;
+      const double change_along = 1.0 - Ncc(p, moved_along.data(), n);
+      const double change_across = 1.0 - Ncc(p, moved_across.data(), n);
+      ratio.push_back(change_along / std::max(change_across, 1e-6));
+    }
+    return !ratio.empty() && Median(ratio) < o_.aperture_max_ratio;
+  }
+
+  // Where the ray from c through x meets the plane (plane coordinates).
+  Eigen::Vector2d OnPlane(const Eigen::Vector3d& c,
+                          const Eigen::Vector3d& x) const {
+    const double sc = seg_.plane.SignedDistance(c);
+    const double sx = seg_.plane.SignedDistance(x);
+    return seg_.frame.ToPlane(c + sc / (sc - sx) * (x - c));
+  }
+
+  static double Ncc(const float* p, const float* q, int n) {
+    double mp = 0, mq = 0;
+    for (int i = 0; i < n; ++i) {
+      mp += p[i];
+      mq += q[i];
+    }
+    mp /= n;
+    mq /= n;
+    double cov = 0, vp = 0, vq = 0;
+    for (int i = 0; i < n; ++i) {
+      cov += (p[i] - mp) * (q[i] - mq);
+      vp += (p[i] - mp) * (p[i] - mp);
+      vq += (q[i] - mq) * (q[i] - mq);
+    }
+    return vp > 0 && vq > 0 ? cov / std::sqrt(vp * vq) : 0.0;
+  }
+
   static double MaxAngleDeg(const std::vector<Eigen::Vector3d>& rays) {
     double min_cos = 1.0;
     for (size_t i = 0; i < rays.size(); ++i) {

@@ -66,6 +66,16 @@ struct PlaneGrowthOptions {
   // Textured cells: median over the views of the NCC of each view's patch
   // with that of the view of the most parallax from it must reach this.
   double min_ncc = 0.8;
+  // A textured cell proves nothing if its texture hardly changes along the
+  // direction in which a surface off the plane would misregister the views
+  // (an edge along the direction of travel matches through any plane): its
+  // patch moved along that direction must decorrelate at least
+  // aperture_max_ratio times as much as moved across it.
+  bool aperture_test = true;
+  // See aperture_test (1 - NCC of the moved patch, along over across).
+  double aperture_max_ratio = 0.25;
+  // The move of aperture_test, in samples (of samples_per_side per cell).
+  double aperture_shift_samples = 2.0;
   // Plain cells: every view's mean within this fraction of the median
   // mean (exposure changes and noise stay within it).
   double max_plain_brightness_diff = 0.12;
