@@ -10,7 +10,10 @@
 // Growth works on a grid of cells in each segment's plane, starting from
 // its polygon. A cell joins the segment when it is seen by enough views
 // with enough parallax, not hidden by another plane, and
-//  - textured: its patch correlates across the views (NCC), or
+//  - textured: its patch correlates across the views (NCC), and its
+//    texture changes along the direction in which a surface off the plane
+//    would misregister them (an edge along the direction of travel
+//    correlates through any plane: the aperture problem), or
 //  - plain: the views agree on its brightness, and it is at most
 //    max_plain_run cells from a cell with texture evidence (or the
 //    original polygon): plain paint agrees from every view, wherever the
