@@ -386,7 +386,8 @@ nlohmann::json GrowthJson(const PlaneGrowthReport& growth) {
                       {"area_after_m2", p.area_after_m2},
                       {"cells_textured", p.cells_textured},
                       {"cells_plain", p.cells_plain},
-                      {"cells_carved", p.cells_carved}});
+                      {"cells_carved", p.cells_carved},
+                      {"cells_hidden", p.cells_hidden}});
   }
   nlohmann::json hypotheses = nlohmann::json::array();
   for (const HypothesisStats& h : growth.hypotheses) {

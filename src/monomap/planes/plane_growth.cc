@@ -63,6 +63,8 @@ void PlaneGrowthOptions::Check() const {
               "growth.aperture_shift_samples", "must be positive");
   CheckOption(aperture_max_ratio >= 0 && aperture_max_ratio <= 1,
               "growth.aperture_max_ratio", "must be in [0, 1]");
+  CheckOption(min_occluder_cells >= 0, "growth.min_occluder_cells",
+              "must be >= 0");
 }
 
 namespace {
@@ -620,6 +622,56 @@ void KeepPlainBetweenProofs(const cv::Mat1b& proof, cv::Mat1b* member,
   }
 }
 
+// Leaves out the fitted polygon's cells that every view that has them in
+// its image sees through one of `occluders` meeting this plane (at more
+// than layer_max_angle_deg): floor behind a wall's foot, taken in by a
+// point misplaced along its rays, that no image shows. Parallel planes are
+// left to the layer rule: a desk under its keyboard stays desk. Returns
+// the cells dropped.
+int DropHiddenCells(const PlaneGrowthOptions& o, const PlaneSegment& seg,
+                    const Grid& grid, const std::vector<View>& views,
+                    const std::vector<const PlaneSegment*>& occluders,
+                    const DistortedProjector& projector, cv::Mat1b* inside) {
+  const double cos_max = std::cos(DegToRad(o.layer_max_angle_deg));
+  std::vector<const PlaneSegment*> crossing;
+  for (const PlaneSegment* b : occluders) {
+    if (std::abs(b->plane.normal.dot(seg.plane.normal)) < cos_max) {
+      crossing.push_back(b);
+    }
+  }
+  if (crossing.empty()) return 0;
+  std::vector<cv::Point> cells;
+  for (int r = 0; r < inside->rows; ++r) {
+    for (int c = 0; c < inside->cols; ++c) {
+      if ((*inside)(r, c)) cells.emplace_back(c, r);
+    }
+  }
+  std::vector<uint8_t> hidden(cells.size(), 0);
+  tbb::parallel_for(size_t{0}, cells.size(), [&](size_t i) {
+    const Eigen::Vector3d x =
+        seg.frame.ToWorld(grid.Centre(cells[i].y, cells[i].x));
+    bool in_image = false;
+    for (const View& v : views) {
+      Eigen::Vector2d px;
+      if (!projector.Project(v.cam_from_world * x, &px) ||
+          !projector.camera().InImage(px)) {
+        continue;
+      }
+      in_image = true;
+      // Not widened as for growth: only an occluder's own polygon takes
+      // away area that points support.
+      if (!Hidden(crossing, v.centre, x, 0.5 * grid.cell, 0.0)) return;
+    }
+    hidden[i] = in_image ? 1 : 0;
+  });
+  int dropped = 0;
+  for (size_t i = 0; i < cells.size(); ++i) {
+    if (hidden[i]) (*inside)(cells[i].y, cells[i].x) = 0;
+    dropped += hidden[i];
+  }
+  return dropped;
+}
+
 // The cells over a hypothesis' landmarks that the images confirm: kept
 // in *inside when textured or plain; textured ones counted in *h. False
 // when too few textured cells correlate across the views, or too many do
@@ -662,7 +714,8 @@ Polygon2d GrowSegment(const PlaneGrowthOptions& o, const PlaneSegment& seg,
                       const std::vector<View>& views,
                       const DistortedProjector& projector,
                       PlaneGrowthStats* stats,
-                      HypothesisStats* hypothesis = nullptr) {
+                      HypothesisStats* hypothesis = nullptr,
+                      const std::vector<const PlaneSegment*>& trusted = {}) {
   if (!g.ok) return hypothesis ? Polygon2d{} : seg.polygon;
   const Grid& grid = g.grid;
   stats->cell_m = grid.cell;
@@ -670,6 +723,10 @@ Polygon2d GrowSegment(const PlaneGrowthOptions& o, const PlaneSegment& seg,
   const CellEvidence judge(o, seg, g, occluders, views, projector,
                            /*compete=*/hypothesis != nullptr);
   cv::Mat1b inside = g.inside.clone(), plain_inside;
+  if (o.drop_hidden_cells) {
+    stats->cells_hidden =
+        DropHiddenCells(o, seg, grid, views, trusted, projector, &inside);
+  }
   if (hypothesis != nullptr &&
       !ConfirmInside(o, judge, &inside, &plain_inside, hypothesis)) {
     return {};
@@ -684,7 +741,8 @@ Polygon2d GrowSegment(const PlaneGrowthOptions& o, const PlaneSegment& seg,
   // A hypothesis' plain cells prove nothing either.
   if (hypothesis != nullptr) proof.setTo(0, plain_inside);
   if (o.plain_between_proofs) KeepPlainBetweenProofs(proof, &member, stats);
-  const bool grew = stats->cells_textured + stats->cells_plain > 0;
+  const bool grew =
+      stats->cells_textured + stats->cells_plain + stats->cells_hidden > 0;
   if (!grew && hypothesis == nullptr) return seg.polygon;
   member *= 255;
   if (o.close_cells > 0) {
@@ -815,14 +873,19 @@ PlaneGrowthReport GrowPlanePolygons(
       stats.area_after_m2 = areas[i];
       if (original[i].size() >= 3) {
         seg.polygon = original[i];  // regrown against the others' growth
-        std::vector<const PlaneSegment*> occluders;
-        for (const PlaneSegment& other : *segments) {
-          if (&other != &seg && other.polygon.size() >= 3) {
-            occluders.push_back(&other);
+        std::vector<const PlaneSegment*> occluders, trusted;
+        for (size_t j = 0; j < segments->size(); ++j) {
+          const PlaneSegment& other = (*segments)[j];
+          if (&other == &seg || other.polygon.size() < 3) continue;
+          occluders.push_back(&other);
+          const double cell = grids[j].ok ? grids[j].grid.cell : 0.0;
+          if (cell > 0 && std::abs(PolygonArea(other.polygon)) >=
+                              options.min_occluder_cells * cell * cell) {
+            trusted.push_back(&other);
           }
         }
         seg.polygon = GrowSegment(options, seg, grids[i], occluders, views,
-                                  projector, &stats);
+                                  projector, &stats, nullptr, trusted);
         stats.area_after_m2 = std::abs(PolygonArea(seg.polygon));
       }
       report.planes.push_back(stats);

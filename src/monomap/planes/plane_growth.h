@@ -107,6 +107,13 @@ struct PlaneGrowthOptions {
   double layer_cells = 3.0;
   // See layer_cells.
   double layer_max_angle_deg = 10.0;
+  // Leave out the fitted polygon's cells that every view having them in its
+  // image sees through another plane meeting this one: no image shows them,
+  // so only a misplaced point can have put them there ...
+  bool drop_hidden_cells = true;
+  // ... through a plane of at least this many of its own cells: one smaller
+  // than a few cells in the images (12 px each) is too little to trust.
+  double min_occluder_cells = 4.0;
   // Holes and notches up to this many cells are closed in the outline.
   int close_cells = 1;
   // A plane hypothesis (plane_hypotheses.h) is kept when at least this
@@ -136,6 +143,7 @@ struct PlaneGrowthStats {
   int cells_textured = 0;  // added on texture evidence
   int cells_plain = 0;     // added as plain bridges
   int cells_carved = 0;    // free space by landmark rays (of the grid)
+  int cells_hidden = 0;    // of the fitted polygon, hidden from every view
 };
 
 // One plane hypothesis' check against the images.

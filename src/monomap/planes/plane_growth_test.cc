@@ -256,6 +256,52 @@ TEST(PlaneGrowth, TextureAlongTheParallaxProvesNoPlane) {
   EXPECT_LT(report.planes[0].area_after_m2, 0.15);
 }
 
+TEST(PlaneGrowth, ThePointsPolygonBehindAWallThatMeetsItIsLeftOut) {
+  const TestScene scene = Room();
+  // The floor's fitted polygon reaches 0.4 m past the front wall (x = 3),
+  // as a wall-foot point misplaced along its rays would pull it; the wall
+  // is a segment too. No view sees the floor there.
+  const TexturedPlane& floor = scene.map.planes[0];  // u = x + 1, v = y + 1.5
+  PlaneSegment floor_seg;
+  floor_seg.id = 0;
+  floor_seg.plane = floor.plane;
+  floor_seg.frame = floor.frame;
+  floor_seg.polygon = {{2.5, 0.8}, {4.4, 0.8}, {4.4, 2.2}, {2.5, 2.2}};
+  PlaneSegment wall = FrontWall(scene, 0.0);
+  wall.id = 1;
+  std::vector<PlaneSegment> segments = {floor_seg, wall};
+  PlaneGrowthReport report =
+      GrowPlanePolygons(GrowthOn(), scene.camera, scene.world_from_cam, {}, {},
+                        Loader(scene), &segments);
+  ASSERT_EQ(report.planes.size(), 2u);
+  const PlaneGrowthStats& f =
+      report.planes[0].plane_id == 0 ? report.planes[0] : report.planes[1];
+  EXPECT_GT(f.cells_hidden, 10);
+  // Area beyond the wall, one cell of slack (m^2).
+  const double c = f.cell_m;
+  auto behind = [c](const Polygon2d& p) {
+    return std::abs(PolygonArea(p)) * (1 - ShareInside(p, -1, 4 + c, -1, 4));
+  };
+  EXPECT_LT(behind(segments[0].polygon), 0.05);
+  // The points' polygon stays as it was, for localization.
+  EXPECT_EQ(segments[0].landmark_polygon, floor_seg.polygon);
+  // Kept, the floor goes on behind the wall.
+  PlaneGrowthOptions keep = GrowthOn();
+  keep.drop_hidden_cells = false;
+  segments = {floor_seg, wall};
+  GrowPlanePolygons(keep, scene.camera, scene.world_from_cam, {}, {},
+                    Loader(scene), &segments);
+  EXPECT_GT(behind(segments[0].polygon), 0.15);  // (0.4 m - a cell) x 1.4 m
+  // A wall too small to trust (under min_occluder_cells of its own cells)
+  // hides nothing.
+  PlaneGrowthOptions strict = GrowthOn();
+  strict.min_occluder_cells = 1e6;
+  segments = {floor_seg, wall};
+  report = GrowPlanePolygons(strict, scene.camera, scene.world_from_cam, {},
+                             {}, Loader(scene), &segments);
+  EXPECT_EQ(report.planes[0].cells_hidden + report.planes[1].cells_hidden, 0);
+}
+
 TEST(PlaneGrowth, PlainCellsOnlyBridgeAndLandmarksBehindCarveFreeSpace) {
   TestScene scene = Room();
   // Flat grey images: every cell is plain and consistent. By default plain
