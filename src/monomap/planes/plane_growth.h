@@ -18,6 +18,9 @@
 //    max_plain_run cells from a cell with texture evidence (or the
 //    original polygon): plain paint agrees from every view, wherever the
 //    plane is, so only texture proves the plane and plain cells only bridge.
+// The fitted polygon itself loses the cells that every view sees only
+// through a crossing plane: a misplaced point can pull a floor's polygon
+// behind a wall's foot, where no image shows it.
 // Free space bounds it: a cell crossed by the viewing rays of landmarks
 // that lie behind the plane is empty (the views looked through it). And a
 // cell over a parallel plane's polygon, a few cells from it, is that
