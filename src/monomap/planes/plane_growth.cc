@@ -59,8 +59,9 @@ void PlaneGrowthOptions::Check() const {
   CheckOption(hypothesis_min_ncc_gain >= 0, "growth.hypothesis_min_ncc_gain",
               "must be >= 0");
   CheckOption(passes >= 1, "growth.passes", "must be >= 1");
-  CheckOption(aperture_shift_samples > 0 && std::isfinite(aperture_shift_samples),
-              "growth.aperture_shift_samples", "must be positive");
+  CheckOption(
+      aperture_shift_samples > 0 && std::isfinite(aperture_shift_samples),
+      "growth.aperture_shift_samples", "must be positive");
   CheckOption(aperture_max_ratio >= 0 && aperture_max_ratio <= 1,
               "growth.aperture_max_ratio", "must be in [0, 1]");
   CheckOption(min_occluder_cells >= 0, "growth.min_occluder_cells",
@@ -198,17 +199,8 @@ class CellJudge {
   bool AlongParallaxOnly(int r, int c, const std::vector<const View*>& seeing,
                          const std::vector<Eigen::Vector3d>& rays,
                          const std::vector<float>& patches) const {
-    size_t a = 0, b = 0;
-    double min_cos = 2.0;
-    for (size_t i = 0; i < rays.size(); ++i) {
-      for (size_t j = i + 1; j < rays.size(); ++j) {
-        if (rays[i].dot(rays[j]) < min_cos) {
-          min_cos = rays[i].dot(rays[j]);
-          a = i;
-          b = j;
-        }
-      }
-    }
+    size_t a = 0, b = 1;
+    MaxAngleDeg(rays, &a, &b);
     // A point a cell off the plane, seen from views a and b, meets the
     // plane at two places: their difference is the misregistration.
     const Eigen::Vector3d off = seg_.frame.ToWorld(grid_.Centre(r, c)) +
@@ -243,6 +235,8 @@ class CellJudge {
     return seg_.frame.ToPlane(c + sc / (sc - sx) * (x - c));
   }
 
+  // Zero-mean normalized cross-correlation of two n-sample patches (0 if
+  // either is flat).
   static double Ncc(const float* p, const float* q, int n) {
     double mp = 0, mq = 0;
     for (int i = 0; i < n; ++i) {
@@ -260,11 +254,17 @@ class CellJudge {
     return vp > 0 && vq > 0 ? cov / std::sqrt(vp * vq) : 0.0;
   }
 
-  static double MaxAngleDeg(const std::vector<Eigen::Vector3d>& rays) {
+  // The angle (deg) between the two rays that part most; *a, *b (if
+  // given) receive their indices.
+  static double MaxAngleDeg(const std::vector<Eigen::Vector3d>& rays,
+                            size_t* a = nullptr, size_t* b = nullptr) {
     double min_cos = 1.0;
     for (size_t i = 0; i < rays.size(); ++i) {
       for (size_t j = i + 1; j < rays.size(); ++j) {
-        min_cos = std::min(min_cos, rays[i].dot(rays[j]));
+        if (rays[i].dot(rays[j]) >= min_cos) continue;
+        min_cos = rays[i].dot(rays[j]);
+        if (a != nullptr) *a = i;
+        if (b != nullptr) *b = j;
       }
     }
     return RadToDeg(std::acos(std::clamp(min_cos, -1.0, 1.0)));
@@ -301,12 +301,8 @@ class CellJudge {
       for (int u = 0; u < nv; ++u) {
         if (rays[u].dot(rays[v]) < rays[w].dot(rays[v])) w = u;
       }
-      const float* p = patches.data() + static_cast<size_t>(v) * n;
-      const float* q = patches.data() + static_cast<size_t>(w) * n;
-      double cov = 0.0;
-      for (int i = 0; i < n; ++i) cov += (p[i] - means[v]) * (q[i] - means[w]);
-      const double denom = stds[v] * stds[w] * n;
-      ncc[v] = denom > 0 ? cov / denom : 0.0;
+      ncc[v] = Ncc(patches.data() + static_cast<size_t>(v) * n,
+                   patches.data() + static_cast<size_t>(w) * n, n);
     }
     const double m = Median(ncc);
     if (median_ncc != nullptr) *median_ncc = m;

@@ -10,10 +10,10 @@
 namespace monomap {
 namespace {
 
+using testing::LiveImage;
 using testing::MakeTestScene;
 using testing::TestLayout;
 using testing::TestScene;
-using testing::LiveImage;
 using testing::TestSceneOptions;
 
 // The localization room (floor and four blob-textured walls 1.2 m high),
@@ -207,7 +207,9 @@ TEST(PlaneGrowth, AHypothesisOverAParallelPlaneMustExplainTheImagesBetter) {
 TestScene BandedWallDrive() {
   TestSceneOptions o;
   o.layout = TestLayout::kRoom;
-  for (int i = 0; i < 30; ++i) o.room.base_poses.push_back({-0.5 + 0.05 * i, 0.9, 0.0});
+  for (int i = 0; i < 30; ++i) {
+    o.room.base_poses.push_back({-0.5 + 0.05 * i, 0.9, 0.0});
+  }
   o.num_frames = 30;
   TestScene scene = MakeTestScene(o);
   cv::Mat& texture = scene.map.planes[3].texture;  // u = x, v = z
