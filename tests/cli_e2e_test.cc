@@ -385,7 +385,8 @@ TEST_F(Cli, GrowPlanesRecoversMoreOfTheSeenStructure) {
                              (grow ? " --grow-planes" : ""));
     ASSERT_EQ(r.exit_code, 0) << r.output;
     std::ifstream report_in(report);
-    const nlohmann::json growth = nlohmann::json::parse(report_in)["plane_growth"];
+    const nlohmann::json build_report = nlohmann::json::parse(report_in);
+    const nlohmann::json& growth = build_report["plane_growth"];
     EXPECT_EQ(growth["planes"].size(), grow ? ReadMap(map).planes.size() : 0u);
     // Plane hypotheses are checked only with growth; a confirmed one is a
     // map plane.
@@ -399,6 +400,17 @@ TEST_F(Cli, GrowPlanesRecoversMoreOfTheSeenStructure) {
       EXPECT_LT(h["plane_id"].get<int>(),
                 static_cast<int>(ReadMap(map).planes.size()));
     }
+    // The planes block counts the map's segments, the confirmed hypotheses'
+    // among them: every point is an inlier of one, or an outlier.
+    const nlohmann::json& planes = build_report["planes"];
+    int confirmed = 0;
+    for (const auto& h : growth["hypotheses"]) confirmed += h["confirmed"].get<bool>();
+    EXPECT_EQ(planes["from_hypotheses"].get<int>(), confirmed);
+    ASSERT_EQ(planes["inliers_per_plane"].size(), planes["planes"].get<size_t>());
+    int inliers = 0;
+    for (const auto& n : planes["inliers_per_plane"]) inliers += n.get<int>();
+    EXPECT_EQ(inliers + planes["outliers"].get<int>(),
+              build_report["exported_points"]["points"].get<int>());
     for (const auto& p : growth["planes"]) {
       EXPECT_GE(p["area_after_m2"].get<double>(),
                 p["area_before_m2"].get<double>());

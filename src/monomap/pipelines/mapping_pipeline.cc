@@ -196,6 +196,23 @@ void AssignInliers(size_t first, const std::vector<PlaneSegment>& segments,
   }
 }
 
+// The fitting report counts the confirmed hypotheses' segments (from `first`
+// on) too, so that it describes the map's planes and outliers.
+void CountHypothesisPlanes(size_t first,
+                           const std::vector<PlaneSegment>& segments,
+                           const std::vector<Landmark>& landmarks,
+                           PlaneFittingReport* planes) {
+  for (size_t i = first; i < segments.size(); ++i) {
+    planes->inliers_per_plane.push_back(
+        static_cast<int>(segments[i].inlier_ids.size()));
+  }
+  planes->from_hypotheses = static_cast<int>(segments.size() - first);
+  planes->num_planes = static_cast<int>(segments.size());
+  planes->num_outliers = static_cast<int>(
+      std::count_if(landmarks.begin(), landmarks.end(),
+                    [](const Landmark& l) { return l.plane_id < 0; }));
+}
+
 // Stages 3 to 5: planes, image-to-plane homographies and texture mosaics.
 void SurfaceStages(const Dataset& dataset, const MappingOptions& options,
                    const Camera& camera,
@@ -221,6 +238,7 @@ void SurfaceStages(const Dataset& dataset, const MappingOptions& options,
                                     landmarks, tracks, load_grey,
                                     &result->segments, hypotheses);
   AssignInliers(fitted, result->segments, &landmarks);
+  CountHypothesisPlanes(fitted, result->segments, landmarks, &report.planes);
   report.timings.push_back({"plane_growth", timer.ElapsedSeconds()});
   auto load_image = [&](int frame) { return dataset.LoadImage(frame, true); };
   timer.Restart();
@@ -351,6 +369,7 @@ nlohmann::json BundleAdjustmentJson(const BundleAdjustmentReport& ba) {
 
 nlohmann::json PlanesJson(const PlaneFittingReport& planes) {
   nlohmann::json j = {{"planes", planes.num_planes},
+                      {"from_hypotheses", planes.from_hypotheses},
                       {"outliers", planes.num_outliers},
                       {"absorbed_outliers", planes.absorbed},
                       {"inliers_per_plane", planes.inliers_per_plane}};

@@ -125,6 +125,9 @@ struct PlaneFittingOptions {
 struct PlaneFittingReport {
   int num_points = 0;                  // landmarks in
   int num_planes = 0;                  // segments out
+  // Of num_planes, segments added after fitting from confirmed plane
+  // hypotheses (growth); the counts below include them.
+  int from_hypotheses = 0;
   std::vector<int> inliers_per_plane;  // per segment, same order
   int num_outliers = 0;                // landmarks on no segment
   int iterations = 0;                  // RANSAC hypotheses drawn in total
