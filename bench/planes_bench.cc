@@ -1,11 +1,13 @@
 // FitPlanes on ~10,000 synthetic landmarks: 4 planes (floor, two walls, a
-// table top) plus 20% outliers, default options (2000 hypotheses per plane).
+// table top) plus 20% outliers, default options (2000 hypotheses per plane);
+// ProposePlaneHypotheses over the points those planes leave free.
 #include <benchmark/benchmark.h>
 
 #include <random>
 #include <vector>
 
 #include "monomap/planes/plane_fitting.h"
+#include "monomap/planes/plane_hypotheses.h"
 #include "monomap/util/random.h"
 
 namespace monomap {
@@ -64,6 +66,46 @@ void BM_FitPlanes(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * state.range(0));
 }
 BENCHMARK(BM_FitPlanes)->Arg(10000)->Unit(benchmark::kMillisecond);
+
+// The argument's count of rooms like MakeLandmarks(10000)'s, 5 m apart
+// along x: a longer map at the same density of points.
+std::vector<Landmark> MakeRooms(int num_rooms) {
+  std::vector<Landmark> lms;
+  for (int r = 0; r < num_rooms; ++r) {
+    for (Landmark lm : MakeLandmarks(10000)) {
+      lm.id = static_cast<FeatureId>(lms.size());
+      lm.x_in_world.x() += 5.0 * r;
+      lms.push_back(lm);
+    }
+  }
+  return lms;
+}
+
+// The proposal's cost in the number of free points (20 % of the points)
+// as the map grows at a constant density.
+void BM_ProposePlaneHypotheses(benchmark::State& state) {
+  std::vector<Landmark> lms = MakeRooms(static_cast<int>(state.range(0)));
+  const PlaneFittingOptions fitting;
+  std::vector<PlaneSegment> segments;
+  const PlaneFittingReport fitted = FitPlanes(fitting, &lms, &segments);
+  const std::vector<Eigen::Vector3d> centers = {{2.0, 1.5, 1.2}};
+  const PlaneHypothesisOptions options;
+  size_t proposed = 0;
+  for (auto _ : state) {
+    const std::vector<PlaneSegment> hyps =
+        ProposePlaneHypotheses(options, fitting, lms, segments, centers);
+    proposed = hyps.size();
+    benchmark::DoNotOptimize(hyps.data());
+  }
+  state.counters["free_points"] = fitted.num_outliers;
+  state.counters["hypotheses"] = static_cast<double>(proposed);
+}
+BENCHMARK(BM_ProposePlaneHypotheses)
+    ->Arg(1)
+    ->Arg(2)
+    ->Arg(4)
+    ->Arg(8)
+    ->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace monomap

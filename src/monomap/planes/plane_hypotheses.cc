@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <unordered_map>
 
 #include "monomap/geometry/polygon.h"
@@ -92,12 +93,55 @@ std::vector<FreePoint> FreePoints(const PlaneHypothesisOptions& o,
   return out;
 }
 
+// The free points seen along one scene direction: each one's offset along
+// it and its band, computed once for every round of the proposal.
+struct DirectionScan {
+  Eigen::Vector3d n, u, v;  // the direction and an in-plane basis
+  std::vector<double> s, band;
+};
+
+DirectionScan ScanAlong(const PlaneFittingOptions& f,
+                        const std::vector<Landmark>& lms,
+                        const std::vector<FreePoint>& pts,
+                        const Eigen::Vector3d& n) {
+  DirectionScan scan;
+  scan.n = n;
+  scan.u = n.unitOrthogonal();
+  scan.v = n.cross(scan.u);
+  for (const FreePoint& p : pts) {
+    scan.s.push_back(n.dot(p.x));
+    scan.band.push_back(Band(f, lms, p, n));
+  }
+  return scan;
+}
+
+// Grid cell of an in-plane position, packed into one key.
+uint64_t CellKey(double a, double b, double cell) {
+  const auto i = static_cast<uint64_t>(static_cast<int64_t>(std::floor(a / cell)));
+  const auto j = static_cast<uint64_t>(static_cast<int64_t>(std::floor(b / cell)));
+  return (i << 32) ^ (j & 0xffffffffu);
+}
+
 // The largest connected group (in-plane distance below the neighbour
-// radius) among points `idx` of a plane with normal n.
+// radius) among points `idx` (ascending) of the scan's plane; ties go to
+// the group of the first point. A grid of cells as wide as the largest
+// radius finds the neighbours, visited in index order.
 std::vector<int> LargestGroup(const PlaneHypothesisOptions& o,
                               const std::vector<FreePoint>& pts,
                               const std::vector<int>& idx,
-                              const Eigen::Vector3d& n) {
+                              const DirectionScan& scan) {
+  double max_depth = 0.0;
+  for (int k : idx) max_depth = std::max(max_depth, pts[k].depth);
+  // A hair wider than the largest radius, so rounding never hides one.
+  const double cell =
+      std::max(o.neighbour_depth_fraction * max_depth * (1.0 + 1e-9), 1e-9);
+  std::unordered_map<uint64_t, std::vector<int>> grid;
+  std::vector<Eigen::Vector2d> uv;
+  for (size_t j = 0; j < idx.size(); ++j) {
+    const Eigen::Vector3d& x = pts[idx[j]].x;
+    uv.emplace_back(scan.u.dot(x), scan.v.dot(x));
+    grid[CellKey(uv[j].x(), uv[j].y(), cell)].push_back(static_cast<int>(j));
+  }
   std::vector<int> label(idx.size(), -1), best;
   for (size_t seed = 0; seed < idx.size(); ++seed) {
     if (label[seed] >= 0) continue;
@@ -105,16 +149,28 @@ std::vector<int> LargestGroup(const PlaneHypothesisOptions& o,
     label[seed] = static_cast<int>(seed);
     for (size_t k = 0; k < group.size(); ++k) {
       const FreePoint& a = pts[idx[group[k]]];
-      for (size_t j = 0; j < idx.size(); ++j) {
-        if (label[j] >= 0) continue;
-        const FreePoint& b = pts[idx[j]];
-        const Eigen::Vector3d d = b.x - a.x;
-        const double in_plane = (d - d.dot(n) * n).norm();
-        if (in_plane < o.neighbour_depth_fraction * 0.5 * (a.depth + b.depth)) {
-          label[j] = static_cast<int>(seed);
-          group.push_back(static_cast<int>(j));
+      const Eigen::Vector2d& c = uv[group[k]];
+      std::vector<int> found;
+      for (int di = -1; di <= 1; ++di) {
+        for (int dj = -1; dj <= 1; ++dj) {
+          const auto it = grid.find(
+              CellKey(c.x() + di * cell, c.y() + dj * cell, cell));
+          if (it == grid.end()) continue;
+          for (int j : it->second) {
+            if (label[j] >= 0) continue;
+            const FreePoint& b = pts[idx[j]];
+            const Eigen::Vector3d d = b.x - a.x;
+            const double in_plane = (d - d.dot(scan.n) * scan.n).norm();
+            if (in_plane <
+                o.neighbour_depth_fraction * 0.5 * (a.depth + b.depth)) {
+              found.push_back(j);
+            }
+          }
         }
       }
+      std::sort(found.begin(), found.end());
+      for (int j : found) label[j] = static_cast<int>(seed);
+      group.insert(group.end(), found.begin(), found.end());
     }
     if (group.size() > best.size()) best = group;
   }
@@ -122,36 +178,90 @@ std::vector<int> LargestGroup(const PlaneHypothesisOptions& o,
   return best;
 }
 
-// The best supported offset along n among the points still free: for each
-// point's offset, the points within their band of it; then its largest
-// connected group.
-std::vector<int> BestGroupAlong(const PlaneHypothesisOptions& o,
-                                const PlaneFittingOptions& f,
-                                const std::vector<Landmark>& lms,
-                                const std::vector<FreePoint>& pts,
+// The unused points within their band of point i's offset, ascending.
+// `by_s` orders the points by offset; `max_band` bounds every band.
+std::vector<int> PointsAtOffset(const DirectionScan& scan,
                                 const std::vector<char>& used,
-                                const Eigen::Vector3d& n) {
-  const int m = static_cast<int>(pts.size());
-  std::vector<double> s(m), band(m);
-  for (int i = 0; i < m; ++i) {
-    s[i] = n.dot(pts[i].x);
-    band[i] = Band(f, lms, pts[i], n);
+                                const std::vector<int>& by_s, double max_band,
+                                int i) {
+  const double si = scan.s[i];
+  const double reach = max_band * (1.0 + 1e-9) + 1e-12;  // never too short
+  auto it = std::lower_bound(
+      by_s.begin(), by_s.end(), si - reach,
+      [&](int j, double value) { return scan.s[j] < value; });
+  std::vector<int> idx;
+  for (; it != by_s.end() && scan.s[*it] <= si + reach; ++it) {
+    const int j = *it;
+    if (!used[j] && std::abs(scan.s[j] - si) <= scan.band[j]) idx.push_back(j);
   }
-  std::vector<int> best;
-  for (int i = 0; i < m; ++i) {
-    if (used[i]) continue;
-    std::vector<int> idx;
-    for (int j = 0; j < m; ++j) {
-      if (!used[j] && std::abs(s[j] - s[i]) <= band[j]) idx.push_back(j);
-    }
-    if (idx.size() < static_cast<size_t>(o.min_points) || idx.size() <= best.size()) {
-      continue;
-    }
-    std::vector<int> group = LargestGroup(o, pts, idx, n);
-    if (group.size() > best.size()) best = std::move(group);
-  }
-  return best;
+  std::sort(idx.begin(), idx.end());
+  return idx;
 }
+
+// Along one direction, each free point's offset proposes the largest
+// connected group among the points within their band of it. A round takes
+// a few points, which changes the groups of the offsets near theirs only,
+// so the group sizes are kept and recomputed where they may have changed:
+// the proposal costs about one pass over the points, not one per round.
+class OffsetGroups {
+ public:
+  OffsetGroups(const PlaneHypothesisOptions& o,
+               const std::vector<FreePoint>& pts, DirectionScan scan)
+      : o_(o), pts_(pts), scan_(std::move(scan)),
+        size_(pts.size(), 0), stale_(pts.size(), 1) {
+    for (int i = 0; i < static_cast<int>(pts.size()); ++i) by_s_.push_back(i);
+    std::sort(by_s_.begin(), by_s_.end(),
+              [&](int a, int b) { return scan_.s[a] < scan_.s[b]; });
+    for (double b : scan_.band) max_band_ = std::max(max_band_, b);
+  }
+
+  const Eigen::Vector3d& direction() const { return scan_.n; }
+
+  // The best group among the points not `used`: the largest, ties to the
+  // first point's offset (points fewer than min_points at an offset
+  // propose none). Empty if no offset proposes one.
+  std::vector<int> Best(const std::vector<char>& used) {
+    int best_i = -1;
+    for (int i = 0; i < static_cast<int>(pts_.size()); ++i) {
+      if (used[i]) continue;
+      if (stale_[i]) Refresh(used, i);
+      if (size_[i] > (best_i < 0 ? 0 : size_[best_i])) best_i = i;
+    }
+    if (best_i < 0) return {};
+    return LargestGroup(o_, pts_, At(used, best_i), scan_);
+  }
+
+  // Marks stale the offsets whose points included newly used point j.
+  void Take(int j) {
+    const double reach = scan_.band[j] * (1.0 + 1e-9) + 1e-12;
+    auto it = std::lower_bound(
+        by_s_.begin(), by_s_.end(), scan_.s[j] - reach,
+        [&](int k, double value) { return scan_.s[k] < value; });
+    for (; it != by_s_.end() && scan_.s[*it] <= scan_.s[j] + reach; ++it) {
+      stale_[*it] = 1;
+    }
+  }
+
+ private:
+  std::vector<int> At(const std::vector<char>& used, int i) const {
+    return PointsAtOffset(scan_, used, by_s_, max_band_, i);
+  }
+  void Refresh(const std::vector<char>& used, int i) {
+    const std::vector<int> idx = At(used, i);
+    size_[i] = idx.size() < static_cast<size_t>(o_.min_points)
+                   ? 0
+                   : static_cast<int>(LargestGroup(o_, pts_, idx, scan_).size());
+    stale_[i] = 0;
+  }
+
+  const PlaneHypothesisOptions& o_;
+  const std::vector<FreePoint>& pts_;
+  DirectionScan scan_;
+  std::vector<int> by_s_;
+  double max_band_ = 0.0;
+  std::vector<int> size_;   // group size of each point's offset
+  std::vector<char> stale_;  // size_ to recompute
+};
 
 // Standard error (rad) of each segment's normal from its inliers
 // (NormalStandardErrorRad; 0 when they are not among the landmarks).
@@ -260,20 +370,27 @@ std::vector<PlaneSegment> ProposePlaneHypotheses(
   const std::vector<FreePoint> pts =
       FreePoints(options, fitting, landmarks, segments);
   const std::vector<double> normal_errors = NormalErrors(landmarks, segments);
+  std::vector<OffsetGroups> along;
+  for (const Eigen::Vector3d& n : dirs) {
+    along.emplace_back(options, pts, ScanAlong(fitting, landmarks, pts, n));
+  }
   std::vector<char> used(pts.size(), 0);
   std::vector<PlaneSegment> out;
   while (static_cast<int>(out.size()) < options.max_hypotheses) {
     std::vector<int> best;
     Eigen::Vector3d best_dir = Eigen::Vector3d::Zero();
-    for (const Eigen::Vector3d& n : dirs) {
-      std::vector<int> g = BestGroupAlong(options, fitting, landmarks, pts, used, n);
+    for (OffsetGroups& groups : along) {
+      std::vector<int> g = groups.Best(used);
       if (g.size() > best.size()) {
         best = std::move(g);
-        best_dir = n;
+        best_dir = groups.direction();
       }
     }
     if (best.size() < static_cast<size_t>(options.min_points)) break;
-    for (int k : best) used[k] = 1;
+    for (int k : best) {
+      used[k] = 1;
+      for (OffsetGroups& groups : along) groups.Take(k);
+    }
     PlaneSegment seg =
         MakeHypothesis(landmarks, pts, best, best_dir, camera_centers);
     std::vector<double> bands;

@@ -100,6 +100,34 @@ TEST(PlaneHypotheses, FewPointsOnAnEndWallAndARecessedDoorMakeHypotheses) {
   }
 }
 
+// Hypotheses come best supported first, and taking one's points changes
+// the support of every offset that counted them: two walls at one offset,
+// far apart (9 and 7 points), and a third wall elsewhere (8 points) come
+// out as 9, 8, 7, not with the 7 still counted as the 9 it shared an
+// offset with.
+TEST(PlaneHypotheses, TakingAWallsPointsUpdatesTheSupportOfItsOffset) {
+  const Corridor c;
+  std::vector<Landmark> lms;
+  FeatureId id = 0;
+  auto wall = [&](int count, double x0, double y, double depth) {
+    for (int i = 0; i < count; ++i) {
+      lms.push_back(Point(id++, {x0 + 0.1 * i, y, 0.2 + 0.13 * i}, depth));
+    }
+  };
+  wall(9, -3.0, 6.0, 5.0);
+  wall(7, 2.2, 6.0, 5.0);
+  wall(8, -0.4, 8.0, 7.0);
+  const std::vector<PlaneSegment> hyp = ProposePlaneHypotheses(
+      PlaneHypothesisOptions(), PlaneFittingOptions(), lms, c.segments,
+      c.centers);
+  ASSERT_EQ(hyp.size(), 3u);
+  EXPECT_EQ(hyp[0].inlier_ids.size(), 9u);
+  EXPECT_EQ(hyp[1].inlier_ids.size(), 8u);
+  EXPECT_NEAR(hyp[1].plane.SignedDistance({0, 8, 0}), 0.0, 1e-9);
+  EXPECT_EQ(hyp[2].inlier_ids.size(), 7u);
+  EXPECT_EQ(hyp[2].inlier_ids.front(), 9u);
+}
+
 TEST(PlaneHypotheses, AWallSeenAgainFurtherAlongIsNoNewPlane) {
   Corridor c;
   std::vector<Landmark> lms;
