@@ -133,6 +133,13 @@ void AddPointTrustOptions(CLI::App* cmd, PointTrustOptions* o) {
                   "bundle adjustment is at most this (px)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
+  cmd->add_option("--max-point-reprojection-ratio",
+                  o->max_reprojection_error_median_ratio,
+                  "Export only points whose mean reprojection error is also "
+                  "at most this many times the median over the map's points "
+                  "(0: off)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   cmd->add_option("--min-point-angle", o->min_triangulation_angle_deg,
                   "Export only points whose observing rays span at least "
                   "this angle (degrees)")

@@ -444,6 +444,7 @@ nlohmann::json ExportedPointsJson(const PointTrustReport& point_trust) {
   return {{"points", point_trust.num_points},
           {"exported", point_trust.num_exported},
           {"keep_all_points", point_trust.keep_all},
+          {"reprojection_limit_px", point_trust.reprojection_limit_px},
           // Per reason: left out, or with keep_all_points exported untrusted.
           {point_trust.keep_all ? "untrusted_kept" : "left_out",
            {{"short_track", point_trust.short_track},

@@ -1,7 +1,9 @@
 #include "monomap/triangulation/point_trust.h"
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "monomap/util/error.h"
 
@@ -14,6 +16,10 @@ void PointTrustOptions::Check() const {
                   std::isfinite(max_mean_reprojection_error_px),
               "point_trust.max_mean_reprojection_error_px",
               "must be positive and finite");
+  CheckOption(max_reprojection_error_median_ratio >= 0.0 &&
+                  std::isfinite(max_reprojection_error_median_ratio),
+              "point_trust.max_reprojection_error_median_ratio",
+              "must be >= 0 and finite");
   CheckOption(
       min_triangulation_angle_deg >= 0.0 && min_triangulation_angle_deg < 180.0,
       "point_trust.min_triangulation_angle_deg", "must be in [0, 180)");
@@ -34,6 +40,27 @@ bool TooUncertain(const Landmark& l, double max_relative) {
   return !(sigma <= max_relative * l.mean_depth_m);
 }
 
+// The mean reprojection error limit: the absolute one, or ratio x the
+// points' median when that is smaller.
+double ReprojectionLimit(const PointTrustOptions& options,
+                         const std::vector<Landmark>& landmarks) {
+  if (options.max_reprojection_error_median_ratio <= 0.0) {
+    return options.max_mean_reprojection_error_px;
+  }
+  std::vector<double> errors;
+  for (const Landmark& l : landmarks) {
+    if (std::isfinite(l.mean_reprojection_error_px)) {
+      errors.push_back(l.mean_reprojection_error_px);
+    }
+  }
+  if (errors.empty()) return options.max_mean_reprojection_error_px;
+  std::nth_element(errors.begin(), errors.begin() + errors.size() / 2,
+                   errors.end());
+  return std::min(options.max_mean_reprojection_error_px,
+                  options.max_reprojection_error_median_ratio *
+                      errors[errors.size() / 2]);
+}
+
 }  // namespace
 
 PointTrustReport FilterTrustedPoints(const PointTrustOptions& options,
@@ -42,6 +69,7 @@ PointTrustReport FilterTrustedPoints(const PointTrustOptions& options,
   PointTrustReport report;
   report.keep_all = options.keep_all;
   report.num_points = static_cast<int>(landmarks->size());
+  report.reprojection_limit_px = ReprojectionLimit(options, *landmarks);
   size_t kept = 0;
   for (size_t i = 0; i < landmarks->size(); ++i) {
     const Landmark& l = (*landmarks)[i];
@@ -50,7 +78,7 @@ PointTrustReport FilterTrustedPoints(const PointTrustOptions& options,
     if (l.num_observations < options.min_track_length) {
       ++report.short_track;
     } else if (!(l.mean_reprojection_error_px <=
-                 options.max_mean_reprojection_error_px)) {
+                 report.reprojection_limit_px)) {
       ++report.reprojection_error;
     } else if (!(l.triangulation_angle_deg >=
                  options.min_triangulation_angle_deg)) {

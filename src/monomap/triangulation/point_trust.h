@@ -19,6 +19,12 @@ struct PointTrustOptions {
   // Largest mean reprojection error (raw px, after bundle adjustment); as
   // triangulation's own limit, since tighter made some runs worse.
   double max_mean_reprojection_error_px = 2.0;
+  // ... and at most this many times the median of all the points' mean
+  // reprojection errors (0: off): the image noise differs between cameras,
+  // so a limit relative to the map's own noise fits every camera; the
+  // largest ratio of those tried that was no worse anywhere in the
+  // generalization set.
+  double max_reprojection_error_median_ratio = 3.0;
   // Smallest largest angle between observing rays (degrees); as
   // triangulation's own limit, for the same reason.
   double min_triangulation_angle_deg = 1.5;
@@ -38,6 +44,9 @@ struct PointTrustOptions {
 struct PointTrustReport {
   int num_points = 0;    // landmarks given
   int num_exported = 0;  // landmarks kept
+  // The mean reprojection error limit applied (px): the absolute one, or
+  // the median ratio's when smaller.
+  double reprojection_limit_px = 0.0;
   // Untrusted points, each counted once under the first test it fails in
   // this order; left out unless keep_all.
   int short_track = 0;

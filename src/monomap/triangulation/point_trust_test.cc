@@ -21,10 +21,10 @@ constexpr int kTiny = 7;   // 8 frames, 21 mm baseline at 2.5 m: ~0.5 deg
 // Landmarks triangulated (with every acceptance test off) from a noisy
 // simulated scene plus planted bad tracks: the quality the filter judges is
 // the one triangulation measured. Ids >= kClean are the planted ones.
-std::vector<Landmark> LandmarksWithPlantedBadPoints() {
+std::vector<Landmark> LandmarksWithPlantedBadPoints(double noise_px = 0.3) {
   testing::TestSceneOptions scene_options;
   scene_options.points.num_tracks = kClean;
-  scene_options.points.pixel_noise_px = 0.3;
+  scene_options.points.pixel_noise_px = noise_px;
   scene_options.seed = 11;
   const testing::TestScene scene = testing::MakeTestScene(scene_options);
   std::vector<Track> tracks = scene.tracks;
@@ -44,7 +44,7 @@ std::vector<Landmark> LandmarksWithPlantedBadPoints() {
     tracks.push_back(t);
   }
   std::mt19937_64 rng(4);
-  std::normal_distribution<double> noise(0.0, 0.3);
+  std::normal_distribution<double> noise(0.0, noise_px);
   for (int k = 0; k < kTiny; ++k) {
     const int frame = 3 * k;
     const Eigen::Vector3d x = scene.world_from_cam[frame + 4] *
@@ -121,6 +121,7 @@ TEST(PointTrustTest, ThresholdsCountExactlyThePointsBeyondThem) {
   PointTrustOptions options;
   options.min_track_length = 12;
   options.max_mean_reprojection_error_px = 0.4;
+  options.max_reprojection_error_median_ratio = 0.0;  // the absolute limit
   options.min_triangulation_angle_deg = 6.0;
   options.max_relative_uncertainty = 0.0;
   int short_track = 0, error = 0, angle = 0;
@@ -157,6 +158,45 @@ TEST(PointTrustTest, ThresholdsCountExactlyThePointsBeyondThem) {
       FilterTrustedPoints(PointTrustOptions{}, &nan_point).reprojection_error,
       1);
   EXPECT_TRUE(nan_point.empty());
+}
+
+// A limit relative to the map's median reprojection error fits any
+// camera's noise: at 0.3 and at 1.2 px of tracking noise, twice the median
+// keeps most clean points and leaves out the tracks that jumped, where one
+// absolute limit (right for the first) leaves out most clean points of the
+// second. The limit applied is reported.
+TEST(PointTrustTest, AMedianRatioLimitFitsTheCamerasNoise) {
+  for (const double noise_px : {0.3, 1.2}) {
+    SCOPED_TRACE(noise_px);
+    const std::vector<Landmark> all = LandmarksWithPlantedBadPoints(noise_px);
+    PointTrustOptions relative;
+    relative.min_track_length = 2;
+    relative.min_triangulation_angle_deg = 0.0;
+    relative.max_relative_uncertainty = 0.0;
+    relative.max_mean_reprojection_error_px = 100.0;
+    relative.max_reprojection_error_median_ratio = 2.0;
+    PointTrustOptions absolute = relative;
+    absolute.max_reprojection_error_median_ratio = 0.0;
+    absolute.max_mean_reprojection_error_px = 0.6;
+    for (const bool use_ratio : {true, false}) {
+      std::vector<Landmark> kept = all;
+      const PointTrustReport report =
+          FilterTrustedPoints(use_ratio ? relative : absolute, &kept);
+      int clean = 0;
+      for (const Landmark& l : kept) {
+        EXPECT_FALSE(l.id >= kClean + kShort && l.id < kClean + kShort + kJumps)
+            << "a track that jumped is kept";
+        clean += l.id < kClean;
+      }
+      if (use_ratio) {
+        EXPECT_GT(clean, 0.9 * kClean);
+        EXPECT_GT(report.reprojection_limit_px, noise_px);
+        EXPECT_LT(report.reprojection_limit_px, 4.0 * noise_px);
+      } else if (noise_px > 1.0) {
+        EXPECT_LT(clean, 0.5 * kClean);
+      }
+    }
+  }
 }
 
 // The points the uncertainty test leaves out are the ones that are really
@@ -225,6 +265,10 @@ TEST(PointTrustTest, CheckRejectsBadValues) {
             std::string::npos);
   o.max_mean_reprojection_error_px = std::nan("");
   EXPECT_NE(error_of(o).find("max_mean_reprojection_error_px"),
+            std::string::npos);
+  o = {};
+  o.max_reprojection_error_median_ratio = -1.0;
+  EXPECT_NE(error_of(o).find("max_reprojection_error_median_ratio"),
             std::string::npos);
   o = {};
   o.max_relative_uncertainty = std::nan("");
