@@ -115,120 +115,51 @@ DirectionScan ScanAlong(const PlaneFittingOptions& f,
   return scan;
 }
 
-// Grid cell of an in-plane position, packed into one key.
-uint64_t CellKey(double a, double b, double cell) {
-  const auto i = static_cast<uint64_t>(static_cast<int64_t>(std::floor(a / cell)));
-  const auto j = static_cast<uint64_t>(static_cast<int64_t>(std::floor(b / cell)));
-  return (i << 32) ^ (j & 0xffffffffu);
-}
-
-// The largest connected group (in-plane distance below the neighbour
-// radius) among points `idx` (ascending) of the scan's plane; ties go to
-// the group of the first point. A grid of cells as wide as the largest
-// radius finds the neighbours, visited in index order.
-std::vector<int> LargestGroup(const PlaneHypothesisOptions& o,
-                              const std::vector<FreePoint>& pts,
-                              const std::vector<int>& idx,
-                              const DirectionScan& scan) {
-  double max_depth = 0.0;
-  for (int k : idx) max_depth = std::max(max_depth, pts[k].depth);
-  // A hair wider than the largest radius, so rounding never hides one.
-  const double cell =
-      std::max(o.neighbour_depth_fraction * max_depth * (1.0 + 1e-9), 1e-9);
-  std::unordered_map<uint64_t, std::vector<int>> grid;
-  std::vector<Eigen::Vector2d> uv;
-  for (size_t j = 0; j < idx.size(); ++j) {
-    const Eigen::Vector3d& x = pts[idx[j]].x;
-    uv.emplace_back(scan.u.dot(x), scan.v.dot(x));
-    grid[CellKey(uv[j].x(), uv[j].y(), cell)].push_back(static_cast<int>(j));
-  }
-  std::vector<int> label(idx.size(), -1), best;
-  for (size_t seed = 0; seed < idx.size(); ++seed) {
-    if (label[seed] >= 0) continue;
-    std::vector<int> group = {static_cast<int>(seed)};
-    label[seed] = static_cast<int>(seed);
-    for (size_t k = 0; k < group.size(); ++k) {
-      const FreePoint& a = pts[idx[group[k]]];
-      const Eigen::Vector2d& c = uv[group[k]];
-      std::vector<int> found;
-      for (int di = -1; di <= 1; ++di) {
-        for (int dj = -1; dj <= 1; ++dj) {
-          const auto it = grid.find(
-              CellKey(c.x() + di * cell, c.y() + dj * cell, cell));
-          if (it == grid.end()) continue;
-          for (int j : it->second) {
-            if (label[j] >= 0) continue;
-            const FreePoint& b = pts[idx[j]];
-            const Eigen::Vector3d d = b.x - a.x;
-            const double in_plane = (d - d.dot(scan.n) * scan.n).norm();
-            if (in_plane <
-                o.neighbour_depth_fraction * 0.5 * (a.depth + b.depth)) {
-              found.push_back(j);
-            }
-          }
-        }
-      }
-      std::sort(found.begin(), found.end());
-      for (int j : found) label[j] = static_cast<int>(seed);
-      group.insert(group.end(), found.begin(), found.end());
-    }
-    if (group.size() > best.size()) best = group;
-  }
-  for (int& k : best) k = idx[k];
-  return best;
-}
-
-// The unused points within their band of point i's offset, ascending.
-// `by_s` orders the points by offset; `max_band` bounds every band.
-std::vector<int> PointsAtOffset(const DirectionScan& scan,
-                                const std::vector<char>& used,
-                                const std::vector<int>& by_s, double max_band,
-                                int i) {
-  const double si = scan.s[i];
-  const double reach = max_band * (1.0 + 1e-9) + 1e-12;  // never too short
-  auto it = std::lower_bound(
-      by_s.begin(), by_s.end(), si - reach,
-      [&](int j, double value) { return scan.s[j] < value; });
-  std::vector<int> idx;
-  for (; it != by_s.end() && scan.s[*it] <= si + reach; ++it) {
-    const int j = *it;
-    if (!used[j] && std::abs(scan.s[j] - si) <= scan.band[j]) idx.push_back(j);
-  }
-  std::sort(idx.begin(), idx.end());
-  return idx;
-}
-
-// Along one direction, each free point's offset proposes the largest
-// connected group among the points within their band of it. A round takes
-// a few points, which changes the groups of the offsets near theirs only,
-// so the group sizes are kept and recomputed where they may have changed:
-// the proposal costs about one pass over the points, not one per round.
+// Along one direction, each free point's offset proposes the connected
+// group through that point (neighbours closer in the plane than a quarter
+// of their depth) of the points within their band of the offset. A round
+// takes a few points, which changes the groups of the offsets near theirs
+// only, so the group sizes are kept and recomputed where they may have
+// changed; a grid over the plane and the offset finds the neighbours. The
+// proposal so costs about one pass over the points, not one per round,
+// and each group what its neighbourhood holds.
 class OffsetGroups {
  public:
   OffsetGroups(const PlaneHypothesisOptions& o,
                const std::vector<FreePoint>& pts, DirectionScan scan)
-      : o_(o), pts_(pts), scan_(std::move(scan)),
-        size_(pts.size(), 0), stale_(pts.size(), 1) {
-    for (int i = 0; i < static_cast<int>(pts.size()); ++i) by_s_.push_back(i);
+      : o_(o), pts_(pts), scan_(std::move(scan)), size_(pts.size(), 0),
+        stale_(pts.size(), 1), visited_(pts.size(), -1) {
+    double max_depth = 0.0, max_band = 0.0;
+    for (const FreePoint& p : pts) max_depth = std::max(max_depth, p.depth);
+    for (double b : scan_.band) max_band = std::max(max_band, b);
+    // A hair wider than the largest radius and band, so that rounding
+    // never hides a neighbour.
+    cell_ = std::max(o.neighbour_depth_fraction * max_depth * (1 + 1e-9), 1e-9);
+    cell_s_ = std::max(max_band * (1 + 1e-9), 1e-9);
+    for (int i = 0; i < static_cast<int>(pts.size()); ++i) {
+      grid_[Key(Cell(i))].push_back(i);
+      by_s_.push_back(i);
+    }
     std::sort(by_s_.begin(), by_s_.end(),
               [&](int a, int b) { return scan_.s[a] < scan_.s[b]; });
-    for (double b : scan_.band) max_band_ = std::max(max_band_, b);
   }
 
   const Eigen::Vector3d& direction() const { return scan_.n; }
 
   // The best group among the points not `used`: the largest, ties to the
-  // first point's offset (points fewer than min_points at an offset
-  // propose none). Empty if no offset proposes one.
+  // first point's. Empty when every point is used.
   std::vector<int> Best(const std::vector<char>& used) {
     int best_i = -1;
     for (int i = 0; i < static_cast<int>(pts_.size()); ++i) {
       if (used[i]) continue;
-      if (stale_[i]) Refresh(used, i);
-      if (size_[i] > (best_i < 0 ? 0 : size_[best_i])) best_i = i;
+      if (stale_[i]) {
+        size_[i] = static_cast<int>(GroupAt(used, i).size());
+        stale_[i] = 0;
+      }
+      if (best_i < 0 || size_[i] > size_[best_i]) best_i = i;
     }
     if (best_i < 0) return {};
-    return LargestGroup(o_, pts_, At(used, best_i), scan_);
+    return GroupAt(used, best_i);
   }
 
   // Marks stale the offsets whose points included newly used point j.
@@ -243,24 +174,60 @@ class OffsetGroups {
   }
 
  private:
-  std::vector<int> At(const std::vector<char>& used, int i) const {
-    return PointsAtOffset(scan_, used, by_s_, max_band_, i);
+  Eigen::Vector3i Cell(int i) const {
+    const Eigen::Vector3d& x = pts_[i].x;
+    return {static_cast<int>(std::floor(scan_.u.dot(x) / cell_)),
+            static_cast<int>(std::floor(scan_.v.dot(x) / cell_)),
+            static_cast<int>(std::floor(scan_.s[i] / cell_s_))};
   }
-  void Refresh(const std::vector<char>& used, int i) {
-    const std::vector<int> idx = At(used, i);
-    size_[i] = idx.size() < static_cast<size_t>(o_.min_points)
-                   ? 0
-                   : static_cast<int>(LargestGroup(o_, pts_, idx, scan_).size());
-    stale_[i] = 0;
+  static uint64_t Key(const Eigen::Vector3i& c) {
+    const auto bits = [](int v) { return static_cast<uint64_t>(v) & 0x1fffff; };
+    return (bits(c.x()) << 42) | (bits(c.y()) << 21) | bits(c.z());
+  }
+
+  // The points connected to point i among the unused ones within their
+  // band of its offset, ascending.
+  std::vector<int> GroupAt(const std::vector<char>& used, int i) {
+    ++stamp_;
+    std::vector<int> group = {i};
+    visited_[i] = stamp_;
+    for (size_t k = 0; k < group.size(); ++k) {
+      const FreePoint& a = pts_[group[k]];
+      const Eigen::Vector3i c = Cell(group[k]);
+      for (int d = 0; d < 27; ++d) {
+        const auto it = grid_.find(
+            Key(c + Eigen::Vector3i(d % 3 - 1, d / 3 % 3 - 1, d / 9 - 1)));
+        if (it == grid_.end()) continue;
+        for (int j : it->second) {
+          if (used[j] || visited_[j] == stamp_ ||
+              !(std::abs(scan_.s[j] - scan_.s[i]) <= scan_.band[j])) {
+            continue;
+          }
+          const FreePoint& b = pts_[j];
+          const Eigen::Vector3d x = b.x - a.x;
+          const double in_plane = (x - x.dot(scan_.n) * scan_.n).norm();
+          if (in_plane < o_.neighbour_depth_fraction * 0.5 * (a.depth + b.depth)) {
+            visited_[j] = stamp_;
+            group.push_back(j);
+          }
+        }
+      }
+    }
+    std::sort(group.begin(), group.end());
+    return group;
   }
 
   const PlaneHypothesisOptions& o_;
   const std::vector<FreePoint>& pts_;
   DirectionScan scan_;
-  std::vector<int> by_s_;
-  double max_band_ = 0.0;
-  std::vector<int> size_;   // group size of each point's offset
+  double cell_ = 1.0;    // grid cell side in the plane (m)
+  double cell_s_ = 1.0;  // ... and along the direction (m)
+  std::unordered_map<uint64_t, std::vector<int>> grid_;
+  std::vector<int> by_s_;    // points by offset
+  std::vector<int> size_;    // group size of each point's offset
   std::vector<char> stale_;  // size_ to recompute
+  std::vector<int> visited_;  // stamp of the last search that reached it
+  int stamp_ = 0;
 };
 
 // Standard error (rad) of each segment's normal from its inliers

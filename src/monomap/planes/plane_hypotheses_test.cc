@@ -101,31 +101,35 @@ TEST(PlaneHypotheses, FewPointsOnAnEndWallAndARecessedDoorMakeHypotheses) {
 }
 
 // Hypotheses come best supported first, and taking one's points changes
-// the support of every offset that counted them: two walls at one offset,
-// far apart (9 and 7 points), and a third wall elsewhere (8 points) come
-// out as 9, 8, 7, not with the 7 still counted as the 9 it shared an
-// offset with.
+// the support of every offset that counted them. On an end wall, 4 far
+// points (bands of 4 cm) join 8 near ones (1 cm) at one offset, and 5 near
+// points 2.5 cm off it lie on their other side: from those 5's offset the
+// far points count (a group of 9), from the far points' offset the 5 do
+// not. Once the 12 are taken, the 5 are a group of 5 only, and a wall of
+// 7 elsewhere comes before them.
 TEST(PlaneHypotheses, TakingAWallsPointsUpdatesTheSupportOfItsOffset) {
   const Corridor c;
   std::vector<Landmark> lms;
   FeatureId id = 0;
-  auto wall = [&](int count, double x0, double y, double depth) {
+  auto row = [&](int count, double x0, double y, double depth) {
     for (int i = 0; i < count; ++i) {
-      lms.push_back(Point(id++, {x0 + 0.1 * i, y, 0.2 + 0.13 * i}, depth));
+      lms.push_back(Point(id, {x0 + 0.1 * i, y, 0.2 + 0.13 * id}, depth));
+      ++id;
     }
   };
-  wall(9, -3.0, 6.0, 5.0);
-  wall(7, 2.2, 6.0, 5.0);
-  wall(8, -0.4, 8.0, 7.0);
+  row(8, -0.8, 6.0, 1.0);    // near, ids 0-7
+  row(4, 0.0, 6.0, 4.0);     // far, ids 8-11
+  row(5, 0.4, 6.025, 1.0);   // near, 2.5 cm off, ids 12-16
+  row(7, -0.35, 8.0, 3.0);   // another wall, ids 17-23
   const std::vector<PlaneSegment> hyp = ProposePlaneHypotheses(
       PlaneHypothesisOptions(), PlaneFittingOptions(), lms, c.segments,
       c.centers);
   ASSERT_EQ(hyp.size(), 3u);
-  EXPECT_EQ(hyp[0].inlier_ids.size(), 9u);
-  EXPECT_EQ(hyp[1].inlier_ids.size(), 8u);
+  EXPECT_EQ(hyp[0].inlier_ids.size(), 12u);
+  EXPECT_EQ(hyp[1].inlier_ids.size(), 7u);
   EXPECT_NEAR(hyp[1].plane.SignedDistance({0, 8, 0}), 0.0, 1e-9);
-  EXPECT_EQ(hyp[2].inlier_ids.size(), 7u);
-  EXPECT_EQ(hyp[2].inlier_ids.front(), 9u);
+  ASSERT_EQ(hyp[2].inlier_ids.size(), 5u);
+  EXPECT_EQ(hyp[2].inlier_ids.front(), 12u);
 }
 
 TEST(PlaneHypotheses, AWallSeenAgainFurtherAlongIsNoNewPlane) {
