@@ -3,9 +3,11 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <utility>
 #include <vector>
 
 #include "monomap/util/error.h"
+#include "monomap/util/stats.h"
 
 namespace monomap {
 
@@ -54,11 +56,9 @@ double ReprojectionLimit(const PointTrustOptions& options,
     }
   }
   if (errors.empty()) return options.max_mean_reprojection_error_px;
-  std::nth_element(errors.begin(), errors.begin() + errors.size() / 2,
-                   errors.end());
   return std::min(options.max_mean_reprojection_error_px,
                   options.max_reprojection_error_median_ratio *
-                      errors[errors.size() / 2]);
+                      UpperMedian(std::move(errors)));
 }
 
 }  // namespace
