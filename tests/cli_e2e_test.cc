@@ -370,6 +370,55 @@ TEST_F(Cli, EvalStructurePrintsTheTableAndWritesJson) {
   EXPECT_NE(j["alignment_scale"].get<double>(), 1.0);
 }
 
+// The export moves plane inliers to their plane's local offset, which
+// brings the exported points (all of them, outliers included) closer to
+// the true surfaces than where triangulation put them; --raw-points keeps
+// the triangulated positions. Scored after the similarity that fits the
+// map's trajectory to the truth (the odometry's 1 % scale error removed).
+TEST_F(Cli, InlierRefinementBringsTheExportedPointsCloserToTheSurfaces) {
+  const fs::path data = *root_ / "data";
+  double median[2];
+  size_t count[2];
+  for (int raw = 0; raw < 2; ++raw) {
+    const std::string tag = raw ? "raw" : "refined";
+    const fs::path map = *root_ / ("map_" + tag);
+    const fs::path report = *root_ / ("report_" + tag + ".json");
+    RunResult r = RunMonomap("build " + data.string() + " -o " + map.string() +
+                             " -q --report " + report.string() +
+                             (raw ? " --raw-points" : ""));
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    std::ifstream report_in(report);
+    const nlohmann::json refinement =
+        nlohmann::json::parse(report_in).at("inlier_refinement");
+    const Map built = ReadMap(map);
+    const auto inliers = std::count_if(
+        built.landmarks.begin(), built.landmarks.end(),
+        [](const Landmark& l) { return l.plane_id >= 0; });
+    EXPECT_GT(inliers, 50);
+    EXPECT_EQ(refinement.at("enabled").get<bool>(), raw == 0);
+    EXPECT_EQ(refinement.at("moved").get<int>(), raw ? 0 : inliers);
+    const fs::path json = *root_ / ("eval_" + tag + ".json");
+    r = RunMonomap("eval structure " + map.string() + " --structure " +
+                   (data / "structure").string() +
+                   " --align sim3-poses --groundtruth " +
+                   (data / "groundtruth.txt").string() + " --json " +
+                   json.string());
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    std::ifstream eval_in(json);
+    const nlohmann::json all = nlohmann::json::parse(eval_in)
+                                   .at("point_error")
+                                   .at("all_landmarks")
+                                   .at("relative_percent");
+    median[raw] = all.at("median").get<double>();
+    count[raw] = all.at("count").get<size_t>();
+  }
+  std::printf("median error of all points: raw %.3f %%, refined %.3f %%\n",
+              median[1], median[0]);
+  // Measured (40 frames, 320x240): 0.105 -> 0.071 %.
+  EXPECT_EQ(count[0], count[1]);
+  EXPECT_LT(median[0], 0.8 * median[1]);
+}
+
 // build --grow-planes: the planes grow beyond
 // their points over what the images explain; the report says by how much,
 // more of the world's seen structure is recovered while the grown area

@@ -119,7 +119,12 @@ void AddLensOptions(CLI::App* cmd, IntrinsicsRefinementOptions* o) {
       ->capture_default_str();
 }
 
-void AddPointTrustOptions(CLI::App* cmd, PointTrustOptions* o) {
+void AddPointTrustOptions(CLI::App* cmd, PointTrustOptions* o,
+                          InlierRefinementOptions* refinement) {
+  cmd->add_flag("--raw-points", [refinement](int64_t) {
+    refinement->enabled = false;
+  }, "Export plane inliers where triangulation put them, not moved to "
+     "their plane's local offset");
   cmd->add_flag("--keep-all-points", o->keep_all,
                 "Export every triangulated point to points.ply, also those "
                 "the map does not trust (the report still counts them)");
@@ -250,7 +255,7 @@ void AddMappingOptions(CLI::App* cmd, BuildArgs* a) {
                 "feature's reference patch)");
   AddBundleAdjustmentOptions(cmd, &o.bundle_adjustment);
   AddLensOptions(cmd, &o.bundle_adjustment.intrinsics);
-  AddPointTrustOptions(cmd, &o.point_trust);
+  AddPointTrustOptions(cmd, &o.point_trust, &o.inlier_refinement);
 }
 
 void RunBuild(const BuildArgs& a) {

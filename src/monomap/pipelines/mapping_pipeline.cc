@@ -24,6 +24,7 @@ void MappingOptions::Check() const {
   homographies.Check();
   mosaic.Check();
   point_trust.Check();
+  inlier_refinement.Check();
   keyframes.Check();
   CheckOption(first_pass_error_factor >= 1.0, "mapping.first_pass_error_factor",
               "must be >= 1");
@@ -307,6 +308,8 @@ MappingResult BuildMap(const Dataset& dataset, const MappingOptions& options) {
   // were fitted from all of them.
   result.report.point_trust =
       FilterTrustedPoints(options.point_trust, &result.map.landmarks);
+  result.report.inlier_refinement = RefineInliersOnPlanes(
+      options.inlier_refinement, result.segments, &result.map.landmarks);
   result.report.total_seconds = total.ElapsedSeconds();
   return result;
 }
@@ -453,6 +456,14 @@ nlohmann::json ExportedPointsJson(const PointTrustReport& point_trust) {
             {"uncertainty", point_trust.uncertainty}}}};
 }
 
+nlohmann::json InlierRefinementJson(const InlierRefinementReport& r) {
+  return {{"enabled", r.enabled},
+          {"moved", r.num_moved},
+          {"median_move_m", r.median_move_m},
+          {"max_move_m", r.max_move_m},
+          {"median_relative_offset", r.median_relative_offset}};
+}
+
 }  // namespace
 
 nlohmann::json MappingReport::ToJson() const {
@@ -488,6 +499,7 @@ nlohmann::json MappingReport::ToJson() const {
       {"median_residual_after_px", homographies.median_residual_after_px}};
   j["mosaics"] = MosaicsJson(mosaic);
   j["exported_points"] = ExportedPointsJson(point_trust);
+  j["inlier_refinement"] = InlierRefinementJson(inlier_refinement);
   nlohmann::json t = nlohmann::json::object();
   for (const auto& s : timings) t[s.name] = s.seconds;
   j["timings_seconds"] = t;

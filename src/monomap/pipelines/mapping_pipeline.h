@@ -10,6 +10,7 @@
 
 #include "monomap/io/dataset.h"
 #include "monomap/map/map.h"
+#include "monomap/planes/inlier_refinement.h"
 #include "monomap/planes/plane_fitting.h"
 #include "monomap/planes/plane_growth.h"
 #include "monomap/planes/plane_hypotheses.h"
@@ -45,6 +46,8 @@ struct MappingOptions {
   // Last: which points the map exports (untrusted ones left out unless
   // point_trust.keep_all). Planes and textures use every point.
   PointTrustOptions point_trust;
+  // Then the exported plane inliers move to their plane's local offset.
+  InlierRefinementOptions inlier_refinement;
   // The first triangulation (against odometry poses, before bundle
   // adjustment) accepts reprojection errors this many times larger.
   double first_pass_error_factor = 4.0;
@@ -88,6 +91,8 @@ struct MappingReport {
   MosaicReport mosaic;
   // Points exported and left out (by reason) by the trust filter.
   PointTrustReport point_trust;
+  // How far the exported plane inliers moved onto their planes.
+  InlierRefinementReport inlier_refinement;
   std::vector<StageTiming> timings;
   double total_seconds = 0.0;
 
