@@ -212,6 +212,17 @@ void AddGrowthOptions(CLI::App* cmd, BuildArgs* a) {
                   "least this much along the parallax as across it")
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
+  cmd->add_flag("!--plane-growth-no-exposure-compensation",
+                o.growth.compensate_exposure,
+                "Compare plain cells' brightness across views without each "
+                "view's exposure gain (estimated from the tracked features)");
+  cmd->add_option("--plane-hypothesis-offset-check",
+                  o.growth.hypothesis_offset_depth_fraction,
+                  "A plane hypothesis is kept only if the images prefer its "
+                  "offset to offsets this fraction of its distance nearer "
+                  "and farther (0: off)")
+      ->check(CLI::Range(0.0, 0.5))
+      ->capture_default_str();
 }
 
 void AddMappingOptions(CLI::App* cmd, BuildArgs* a) {

@@ -416,11 +416,14 @@ nlohmann::json GrowthJson(const PlaneGrowthReport& growth) {
     hypotheses.push_back({{"inliers", h.inliers},
                           {"cells_textured", h.cells_textured},
                           {"cells_inconsistent", h.cells_inconsistent},
+                          {"offset_ncc_gain", h.offset_ncc_gain},
                           {"confirmed", h.confirmed},
                           {"plane_id", h.plane_id},
                           {"area_m2", h.area_m2}});
   }
   return {{"views", growth.views},
+          {"exposure_gain_min", growth.min_exposure_gain},
+          {"exposure_gain_max", growth.max_exposure_gain},
           {"seconds", growth.seconds},
           {"planes", planes},
           {"hypotheses", hypotheses}};

@@ -7,7 +7,9 @@
 #include <numeric>
 #include <opencv2/imgproc.hpp>
 #include <string>
+#include <tuple>
 #include <unordered_map>
+#include <utility>
 
 #include "monomap/camera/distorted_projector.h"
 #include "monomap/geometry/polygon.h"
@@ -56,6 +58,11 @@ void PlaneGrowthOptions::Check() const {
   CheckOption(hypothesis_min_textured_fraction >= 0 &&
                   hypothesis_min_textured_fraction <= 1,
               "growth.hypothesis_min_textured_fraction", "must be in [0, 1]");
+  CheckOption(hypothesis_offset_depth_fraction >= 0,
+              "growth.hypothesis_offset_depth_fraction", "must be >= 0");
+  CheckOption(hypothesis_min_offset_ncc_gain > -1 &&
+                  hypothesis_min_offset_ncc_gain < 1,
+              "growth.hypothesis_min_offset_ncc_gain", "must be in (-1, 1)");
   CheckOption(hypothesis_min_ncc_gain >= 0, "growth.hypothesis_min_ncc_gain",
               "must be >= 0");
   CheckOption(passes >= 1, "growth.passes", "must be >= 1");
@@ -72,9 +79,11 @@ namespace {
 
 // A frame used as a view: its grey image and pose.
 struct View {
+  int frame = 0;
   cv::Mat1b grey;
   Rigid3d cam_from_world;
   Eigen::Vector3d centre;
+  double exposure_gain = 1.0;  // brightness relative to the other views
 };
 
 // Whether the ray from c to x meets another segment at least `clearance`
@@ -133,6 +142,7 @@ class CellJudge {
     std::vector<float> patches;  // n values per seeing view
     std::vector<Eigen::Vector3d> rays;
     std::vector<const View*> seeing;
+    std::vector<double> gains;
     const Eigen::Vector3d centre = seg_.frame.ToWorld(grid_.Centre(r, c));
     for (const View& v : views_) {
       const Eigen::Vector3d ray = centre - v.centre;
@@ -147,12 +157,13 @@ class CellJudge {
       if (!Sample(v, r, c, Eigen::Vector2d::Zero(), &patches)) continue;
       rays.push_back(ray / dist);
       seeing.push_back(&v);
+      gains.push_back(v.exposure_gain);
     }
     const int nv = static_cast<int>(rays.size());
     if (nv < o_.min_views || MaxAngleDeg(rays) < o_.min_parallax_deg) {
       return Evidence::kNone;
     }
-    const Evidence e = Photometric(patches, rays, n, ncc);
+    const Evidence e = Photometric(patches, rays, gains, n, ncc);
     if (e == Evidence::kTextured && o_.aperture_test &&
         AlongParallaxOnly(r, c, seeing, rays, patches)) {
       if (ncc != nullptr) *ncc = -1.0;
@@ -272,10 +283,11 @@ class CellJudge {
 
   // Textured: NCC of each view's patch with the patch of the view whose
   // ray differs most from its own (the most parallax: a surface off the
-  // plane shifts most there). Plain: the views' mean brightness against
-  // their median.
+  // plane shifts most there). Plain: the views' mean brightness, over
+  // their exposure gains, against their median.
   Evidence Photometric(const std::vector<float>& patches,
-                       const std::vector<Eigen::Vector3d>& rays, int n,
+                       const std::vector<Eigen::Vector3d>& rays,
+                       const std::vector<double>& gains, int n,
                        double* median_ncc) const {
     const int nv = static_cast<int>(rays.size());
     std::vector<double> means(nv), stds(nv);
@@ -284,7 +296,7 @@ class CellJudge {
       const double mean = std::accumulate(p, p + n, 0.0) / n;
       double var = 0.0;
       for (int i = 0; i < n; ++i) var += (p[i] - mean) * (p[i] - mean);
-      means[v] = mean;
+      means[v] = mean / gains[v];
       stds[v] = std::sqrt(var / n);
     }
     if (Median(stds) < o_.min_texture_std) {
@@ -438,19 +450,24 @@ cv::Mat1i ClaimedByOthers(const PlaneGrowthOptions& o, const PlaneSegment& seg,
   return owner;
 }
 
-// The segment's plane and frame moved along its normal onto `rival` (a
-// parallel plane: ClaimedByOthers) at its polygon's centroid: the same
-// cells, seen as lying on the rival.
-PlaneSegment OntoRival(const PlaneSegment& seg, const PlaneSegment& rival) {
-  const Eigen::Vector3d c = seg.frame.ToWorld(PolygonCentroid(seg.polygon));
-  const double shift = -rival.plane.SignedDistance(c) /
-                       rival.plane.normal.dot(seg.plane.normal);
+// The segment's plane and frame moved `shift` (m) along its normal: the
+// same grid cells, on a parallel plane.
+PlaneSegment Shifted(const PlaneSegment& seg, double shift) {
   PlaneSegment moved;
   moved.plane = seg.plane;
   moved.frame = seg.frame;
   moved.frame.origin += shift * seg.plane.normal;
   moved.plane.offset -= shift;
   return moved;
+}
+
+// The segment's plane and frame moved along its normal onto `rival` (a
+// parallel plane: ClaimedByOthers) at its polygon's centroid: the same
+// cells, seen as lying on the rival.
+PlaneSegment OntoRival(const PlaneSegment& seg, const PlaneSegment& rival) {
+  const Eigen::Vector3d c = seg.frame.ToWorld(PolygonCentroid(seg.polygon));
+  return Shifted(seg, -rival.plane.SignedDistance(c) /
+                          rival.plane.normal.dot(seg.plane.normal));
 }
 
 // What a cell of a segment's grid shows: free space (carved) gives no
@@ -770,6 +787,7 @@ std::vector<View> LoadViews(const PlaneGrowthOptions& o, const Camera& camera,
     if (img.depth() != CV_8U) {
       throw InputError("image of frame " + std::to_string(f) + " is not 8-bit");
     }
+    views[i].frame = f;
     views[i].grey = img;
     views[i].cam_from_world = world_from_cam[f].Inverse();
     views[i].centre = world_from_cam[f].translation;
@@ -780,6 +798,52 @@ std::vector<View> LoadViews(const PlaneGrowthOptions& o, const Camera& camera,
 // Checks the hypotheses against the images, most landmarks first (see
 // GrowPlanePolygons); confirmed ones join *segments and hide what lies
 // behind them from the next.
+constexpr double kNoGain = -10.0;  // a cell OffsetNccGain could not judge
+
+// Median distance (m) from the views to the centroid of a segment's
+// polygon: the depth at which the views see it.
+double MedianViewDistance(const PlaneSegment& seg,
+                          const std::vector<View>& views) {
+  const Eigen::Vector3d c = seg.frame.ToWorld(PolygonCentroid(seg.polygon));
+  std::vector<double> distances;
+  for (const View& v : views) distances.push_back((c - v.centre).norm());
+  return Median(distances);
+}
+
+// How well the images pin a hypothesis' offset down: over the cells of its
+// hull that correlate on its plane, the median of their NCC minus the
+// better of their NCCs on the plane moved `shift` either way along the
+// normal (cells that either moved plane cannot judge are skipped; kNoGain
+// if none is left).
+double OffsetNccGain(const PlaneGrowthOptions& o, const PlaneSegment& seg,
+                     const SegmentGrid& g,
+                     const std::vector<const PlaneSegment*>& occluders,
+                     const std::vector<View>& views,
+                     const DistortedProjector& projector, double shift) {
+  const PlaneSegment nearer = Shifted(seg, -shift), farther = Shifted(seg, shift);
+  const CellJudge at(o, seg, g.grid, views, occluders, projector);
+  const CellJudge at_nearer(o, nearer, g.grid, views, occluders, projector);
+  const CellJudge at_farther(o, farther, g.grid, views, occluders, projector);
+  std::vector<cv::Point> cells;
+  for (int r = 0; r < g.inside.rows; ++r) {
+    for (int c = 0; c < g.inside.cols; ++c) {
+      if (g.inside(r, c)) cells.emplace_back(c, r);
+    }
+  }
+  std::vector<double> gain(cells.size(), kNoGain);
+  tbb::parallel_for(size_t{0}, cells.size(), [&](size_t i) {
+    const cv::Point& p = cells[i];
+    double ncc = -1.0, ncc_nearer = -1.0, ncc_farther = -1.0;
+    if (at.Judge(p.y, p.x, &ncc) != Evidence::kTextured) return;
+    at_nearer.Judge(p.y, p.x, &ncc_nearer);
+    at_farther.Judge(p.y, p.x, &ncc_farther);
+    if (ncc_nearer < -0.5 || ncc_farther < -0.5) return;  // not judged
+    gain[i] = ncc - std::max(ncc_nearer, ncc_farther);
+  });
+  gain.erase(std::remove(gain.begin(), gain.end(), kNoGain), gain.end());
+  return gain.empty() ? kNoGain : Median(gain);
+}
+
 void ConfirmHypotheses(
     const PlaneGrowthOptions& o, const std::vector<View>& views,
     const DistortedProjector& projector,
@@ -808,6 +872,12 @@ void ConfirmHypotheses(
     const Polygon2d grown =
         GrowSegment(o, seg, g, occluders, views, projector, &stats, &h);
     h.confirmed = grown.size() >= 3;
+    if (h.confirmed && o.hypothesis_offset_depth_fraction > 0) {
+      h.offset_ncc_gain = OffsetNccGain(
+          o, seg, g, occluders, views, projector,
+          o.hypothesis_offset_depth_fraction * MedianViewDistance(seg, views));
+      h.confirmed = h.offset_ncc_gain > o.hypothesis_min_offset_ncc_gain;
+    }
     if (h.confirmed) {
       seg.id = static_cast<int>(segments->size());
       seg.landmark_polygon = seg.polygon;
@@ -825,6 +895,50 @@ void ConfirmHypotheses(
 
 }  // namespace
 
+// Each view's exposure gain relative to the others, from the tracks: a
+// feature's surroundings (a box mean around it) brighten and darken with
+// the frames that see it, so a view's gain is the median over its features
+// of their brightness there over their median across the views. Views
+// with too few features keep 1. Returns the smallest and largest gain.
+std::pair<double, double> EstimateExposureGains(const std::vector<Track>& tracks,
+                                                std::vector<View>* views) {
+  constexpr int kHalfBox = 4;        // 9 x 9 px: robust to sub-pixel drift
+  constexpr int kMinFeatures = 20;   // per view, for a gain
+  constexpr double kMinBrightness = 10.0;  // darker: noise, not exposure
+  std::unordered_map<int, size_t> view_of_frame;
+  for (size_t v = 0; v < views->size(); ++v) view_of_frame[(*views)[v].frame] = v;
+  std::vector<std::vector<double>> ratios(views->size());
+  std::vector<std::pair<size_t, double>> seen;
+  for (const Track& t : tracks) {
+    seen.clear();
+    for (const Observation& o : t.observations) {
+      const auto it = view_of_frame.find(o.frame);
+      if (it == view_of_frame.end()) continue;
+      const cv::Mat1b& grey = (*views)[it->second].grey;
+      const cv::Rect box(static_cast<int>(std::lround(o.px.x())) - kHalfBox,
+                         static_cast<int>(std::lround(o.px.y())) - kHalfBox,
+                         2 * kHalfBox + 1, 2 * kHalfBox + 1);
+      if ((box & cv::Rect(0, 0, grey.cols, grey.rows)) != box) continue;
+      seen.emplace_back(it->second, cv::mean(grey(box))[0]);
+    }
+    if (seen.size() < 2) continue;
+    std::vector<double> values;
+    for (const auto& s : seen) values.push_back(s.second);
+    const double median = Median(values);
+    if (median < kMinBrightness) continue;
+    for (const auto& s : seen) ratios[s.first].push_back(s.second / median);
+  }
+  double lo = 1.0, hi = 1.0;
+  for (size_t v = 0; v < views->size(); ++v) {
+    if (static_cast<int>(ratios[v].size()) < kMinFeatures) continue;
+    const double gain = Median(std::move(ratios[v]));
+    (*views)[v].exposure_gain = gain;
+    lo = std::min(lo, gain);
+    hi = std::max(hi, gain);
+  }
+  return {lo, hi};
+}
+
 PlaneGrowthReport GrowPlanePolygons(
     const PlaneGrowthOptions& options, const Camera& camera,
     const std::vector<Rigid3d>& world_from_cam,
@@ -837,9 +951,13 @@ PlaneGrowthReport GrowPlanePolygons(
   if (!options.enabled || segments->empty() || world_from_cam.size() < 2) {
     return report;
   }
-  const std::vector<View> views =
+  std::vector<View> views =
       LoadViews(options, camera, world_from_cam, load_grey);
   report.views = static_cast<int>(views.size());
+  if (options.compensate_exposure) {
+    std::tie(report.min_exposure_gain, report.max_exposure_gain) =
+        EstimateExposureGains(tracks, &views);
+  }
   const DistortedProjector projector(camera);
   std::unordered_map<FeatureId, const Track*> track_by_id;
   for (const Track& t : tracks) track_by_id[t.id] = &t;

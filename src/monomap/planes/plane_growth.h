@@ -83,8 +83,14 @@ struct PlaneGrowthOptions {
   // The move of aperture_test, in samples (of samples_per_side per cell).
   double aperture_shift_samples = 2.0;
   // Plain cells: every view's mean within this fraction of the median
-  // mean (exposure changes and noise stay within it).
+  // mean (noise and what exposure compensation leaves stay within it).
   double max_plain_brightness_diff = 0.12;
+  // Divide each view's brightness by its exposure gain relative to the
+  // other views before the plain test: auto-exposure brightens and darkens
+  // whole frames, which the test would otherwise take for a surface that
+  // differs between the views. Gains from the tracked features
+  // (EstimateExposureGains).
+  bool compensate_exposure = true;
   // Plain cells may extend at most this many cells from texture evidence.
   int max_plain_run = 8;
   // ... and must lie within the convex hull of the fitted polygon and the
@@ -129,6 +135,17 @@ struct PlaneGrowthOptions {
   // A hypothesis' cell over a parallel plane's polygon (see layer_cells)
   // is its own only if its NCC beats that plane's by this much.
   double hypothesis_min_ncc_gain = 0.05;
+  // A hypothesis the images confirm must also pin its offset down: over
+  // its correlating cells, the median of its NCC minus the better NCC of
+  // its plane moved this fraction of the views' median distance to it
+  // along the normal, either way, must exceed
+  // hypothesis_min_offset_ncc_gain: the images must prefer its offset.
+  // Far ahead, with little parallax, a plane some cm off correlates as
+  // well as the surface, or better (0: no such test).
+  double hypothesis_offset_depth_fraction = 0.01;
+  // See hypothesis_offset_depth_fraction. Smooth blob texture at 2-3 m
+  // gains only about 0.02 over 2.5 cm, so the bar is the sign.
+  double hypothesis_min_offset_ncc_gain = 0.0;
   // Growth passes: each regrows every segment from its fitted polygon,
   // hidden by the others as the previous pass grew them (a wall below a
   // floor that had not grown yet).
@@ -154,6 +171,10 @@ struct HypothesisStats {
   int inliers = 0;             // its landmarks
   int cells_textured = 0;      // over its hull, correlating across the views
   int cells_inconsistent = 0;  // ... judged but not correlating
+  // Median NCC gain of its correlating cells over its plane moved along
+  // the normal (hypothesis_offset_depth_fraction); 0 if not tested, -10
+  // if no cell could be judged.
+  double offset_ncc_gain = 0.0;
   bool confirmed = false;      // kept as a segment
   int plane_id = -1;           // its segment id if confirmed
   double area_m2 = 0.0;        // its polygon after growth if confirmed
@@ -163,6 +184,9 @@ struct PlaneGrowthReport {
   std::vector<PlaneGrowthStats> planes;  // the segments', then hypotheses'
   std::vector<HypothesisStats> hypotheses;
   int views = 0;  // frames used as views
+  // Smallest and largest exposure gain of a view (1: none estimated).
+  double min_exposure_gain = 1.0;
+  double max_exposure_gain = 1.0;
   double seconds = 0.0;
 };
 

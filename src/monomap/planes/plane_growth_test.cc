@@ -139,6 +139,8 @@ TEST(PlaneGrowth, AHypothesisTheImagesConfirmJoinsAndGrows) {
   ASSERT_EQ(report.hypotheses.size(), 1u);
   const HypothesisStats& h = report.hypotheses[0];
   EXPECT_TRUE(h.confirmed);
+  // The images prefer its offset to 2.5 cm nearer or farther.
+  EXPECT_GT(h.offset_ncc_gain, 0.0);
   EXPECT_EQ(h.inliers, 8);
   // The 0.4 x 0.3 m patch holds 12 cells of about 10 cm here (12 image
   // pixels at 2-3 m): all of them correlate.
@@ -165,6 +167,30 @@ TEST(PlaneGrowth, AHypothesisOffTheSurfaceIsNotConfirmed) {
   EXPECT_GE(report.hypotheses[0].cells_inconsistent, 11);  // of 12
   EXPECT_LE(report.hypotheses[0].cells_textured, 1);
   EXPECT_EQ(segments.size(), 1u);
+}
+
+// A hypothesis a few cm off the wall correlates across the views nearly as
+// well as the wall (this smooth blob texture shifts by 1-3 px), so the
+// correlation alone confirms it; moving it along its normal shows that
+// the images prefer another offset.
+TEST(PlaneGrowth, AHypothesisWhoseOffsetTheImagesDoNotPreferIsNotConfirmed) {
+  const TestScene scene = Room();
+  for (double offset_m : {0.05, -0.05}) {
+    PlaneGrowthOptions options = GrowthOn();
+    options.hypothesis_offset_depth_fraction = 0.0;
+    std::vector<PlaneSegment> segments = BackWall(scene);
+    PlaneGrowthReport report = GrowPlanePolygons(
+        options, scene.camera, scene.world_from_cam, {}, {}, Loader(scene),
+        &segments, {Hypothesis(scene, offset_m)});
+    EXPECT_TRUE(report.hypotheses[0].confirmed) << offset_m;
+    segments = BackWall(scene);
+    report = GrowPlanePolygons(GrowthOn(), scene.camera, scene.world_from_cam,
+                               {}, {}, Loader(scene), &segments,
+                               {Hypothesis(scene, offset_m)});
+    EXPECT_FALSE(report.hypotheses[0].confirmed) << offset_m;
+    EXPECT_LT(report.hypotheses[0].offset_ncc_gain, 0.0) << offset_m;
+    EXPECT_EQ(segments.size(), 1u);
+  }
 }
 
 // The whole front wall as a fitted segment, `offset_m` towards the
@@ -357,6 +383,43 @@ TEST(PlaneGrowth, PlainCellsOnlyBridgeAndLandmarksBehindCarveFreeSpace) {
   // The carved cells stop growth on the left, not on the right.
   EXPECT_GT(lo.x(), 1.3 - 1.5 * c);
   EXPECT_NEAR(hi.x(), 1.7 + 3 * c, 1.0 * c);
+}
+
+// Auto-exposure brightens and darkens whole frames. Flat grey frames
+// alternately 20 % darker and brighter than their median: plain cells
+// agree across the views only once each view's gain, estimated from the
+// tracked features' surroundings, is divided out.
+TEST(PlaneGrowth, ExposureChangesBetweenViewsAreCompensated) {
+  TestScene scene = Room();
+  for (size_t f = 0; f < scene.images.size(); ++f) {
+    scene.images[f].setTo(cv::Scalar::all(f % 2 == 0 ? 100 : 150));
+  }
+  std::vector<Track> tracks(30);
+  for (int i = 0; i < 30; ++i) {
+    tracks[i].id = static_cast<FeatureId>(i);
+    for (int f = 0; f < 30; ++f) {
+      tracks[i].observations.push_back({f, {50.0 + 10 * i, 100.0}});
+    }
+  }
+  PlaneGrowthOptions options = GrowthOn();
+  options.max_plain_run = 3;
+  options.plain_between_proofs = false;
+  for (bool compensate : {false, true}) {
+    options.compensate_exposure = compensate;
+    std::vector<PlaneSegment> segments = {FrontWallPatch(scene, 0.0)};
+    const PlaneGrowthReport report =
+        GrowPlanePolygons(options, scene.camera, scene.world_from_cam, {},
+                          tracks, Loader(scene), &segments);
+    if (compensate) {
+      EXPECT_NEAR(report.min_exposure_gain, 0.8, 0.01);
+      EXPECT_NEAR(report.max_exposure_gain, 1.2, 0.01);
+      EXPECT_GT(report.planes[0].cells_plain, 20);
+    } else {
+      EXPECT_EQ(report.min_exposure_gain, 1.0);
+      EXPECT_EQ(report.max_exposure_gain, 1.0);
+      EXPECT_EQ(report.planes[0].cells_plain, 0);
+    }
+  }
 }
 
 TEST(PlaneGrowth, DisabledLeavesThePolygons) {
