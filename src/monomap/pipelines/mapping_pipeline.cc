@@ -308,8 +308,11 @@ MappingResult BuildMap(const Dataset& dataset, const MappingOptions& options) {
   // were fitted from all of them.
   result.report.point_trust =
       FilterTrustedPoints(options.point_trust, &result.map.landmarks);
+  Timer refinement;
   result.report.inlier_refinement = RefineInliersOnPlanes(
       options.inlier_refinement, result.segments, &result.map.landmarks);
+  result.report.timings.push_back(
+      {"inlier_refinement", refinement.ElapsedSeconds()});
   result.report.total_seconds = total.ElapsedSeconds();
   return result;
 }

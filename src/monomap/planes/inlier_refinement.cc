@@ -156,8 +156,12 @@ InlierRefinementReport RefineInliersOnPlanes(
   for (size_t s = 0; s < segments.size(); ++s) segment_of_id[segments[s].id] = s;
   std::vector<std::vector<int>> members(segments.size());
   for (int i = 0; i < static_cast<int>(landmarks->size()); ++i) {
-    const auto it = segment_of_id.find((*landmarks)[i].plane_id);
-    if (it != segment_of_id.end()) members[it->second].push_back(i);
+    const Landmark& l = (*landmarks)[i];
+    const auto it = segment_of_id.find(l.plane_id);
+    // A point that is not finite has no place on a plane; it stays.
+    if (it != segment_of_id.end() && l.x_in_world.allFinite()) {
+      members[it->second].push_back(i);
+    }
   }
   std::vector<double> moves, relative_offsets;
   for (size_t s = 0; s < segments.size(); ++s) {
