@@ -1,5 +1,7 @@
 #include "monomap/eval/checkerboard_accuracy.h"
 
+#include <Eigen/Geometry>
+
 #include <yaml-cpp/yaml.h>
 
 #include <limits>
@@ -43,10 +45,31 @@ cv::Mat GreyOnWhite(const cv::Mat& texture) {
   return grey;
 }
 
+// Corner errors after the rigid motion that best fits `mapped` (in the
+// spec's order) to the true corners (least squares, Umeyama).
+ErrorStats ShapeError(const std::vector<Eigen::Vector3d>& mapped,
+                      const CheckerboardSpec& spec) {
+  const int n = static_cast<int>(mapped.size());
+  Eigen::Matrix3Xd from(3, n), to(3, n);
+  for (int k = 0; k < n; ++k) {
+    from.col(k) = mapped[k];
+    to.col(k) = spec.Corner(k % spec.inner_corners_x, k / spec.inner_corners_x);
+  }
+  const Eigen::Matrix4d fit = Eigen::umeyama(from, to, /*with_scaling=*/false);
+  std::vector<double> errors;
+  for (int k = 0; k < n; ++k) {
+    const Eigen::Vector3d moved =
+        fit.topLeftCorner<3, 3>() * from.col(k) + fit.topRightCorner<3, 1>();
+    errors.push_back((moved - to.col(k)).norm());
+  }
+  return ComputeErrorStats(errors);
+}
+
 }  // namespace
 
 CheckerboardAccuracy EvaluateCheckerboard(const Map& map,
-                                          const CheckerboardSpec& spec) {
+                                          const CheckerboardSpec& spec,
+                                          const Sim3d& truth_from_map) {
   CheckerboardAccuracy result;
   const cv::Size pattern(spec.inner_corners_x, spec.inner_corners_y);
   for (const TexturedPlane& plane : map.planes) {
@@ -70,7 +93,9 @@ CheckerboardAccuracy EvaluateCheckerboard(const Map& map,
                          0.01));
     std::vector<Eigen::Vector3d> mapped;
     for (const auto& c : corners) {
-      mapped.push_back(plane.WorldFromTexture(Eigen::Vector2d(c.x, c.y)));
+      mapped.push_back(truth_from_map.rigid *
+                       (truth_from_map.scale *
+                        plane.WorldFromTexture(Eigen::Vector2d(c.x, c.y))));
     }
     // OpenCV orders corners row by row along the pattern's width (x),
     // starting at any of the board's four corners (and the texture may be
@@ -97,6 +122,7 @@ CheckerboardAccuracy EvaluateCheckerboard(const Map& map,
       }
     }
     mapped = best_order;
+    result.shape_error_m = ShapeError(mapped, spec);
     result.found = true;
     result.plane_id = plane.id;
     result.corners_found = static_cast<int>(mapped.size());

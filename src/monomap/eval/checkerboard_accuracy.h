@@ -9,6 +9,7 @@
 #include <Eigen/Core>
 
 #include "monomap/eval/point_accuracy.h"
+#include "monomap/eval/trajectory_metrics.h"
 #include "monomap/map/map.h"
 
 namespace monomap {
@@ -40,6 +41,10 @@ struct CheckerboardAccuracy {
   std::string detector;
   // Distances between the mapped texture corners and the true corners (m).
   ErrorStats error_m;
+  // ... after the one rigid motion that best fits the mapped corners to
+  // the true ones: the board's shape in the map, without where the map's
+  // frame (its odometry's) puts it.
+  ErrorStats shape_error_m;
   // Mapped corner positions in world coordinates, in the spec's order.
   std::vector<Eigen::Vector3d> corners_in_world;
 };
@@ -51,9 +56,13 @@ struct CheckerboardAccuracy {
 // plane's extent runs close to the outer squares; the sector-based one
 // does not (on the desk texture either one was the sole finder in some
 // builds). The detection's ordering ambiguity (start corner, mirroring) is
-// resolved by taking the ordering with the smallest error.
+// resolved by taking the ordering with the smallest error. The corners
+// are compared in the truth's frame: truth_from_map (scale, then rigid)
+// moves them there, the identity by default (a monocular map's frame is
+// its odometry's: see the trajectory alignment, AlignTrajectories).
 CheckerboardAccuracy EvaluateCheckerboard(const Map& map,
-                                          const CheckerboardSpec& spec);
+                                          const CheckerboardSpec& spec,
+                                          const Sim3d& truth_from_map = {});
 
 // Reads the `chessboard:` entry of a ground-truth structure YAML
 // ({inner_corners_x, inner_corners_y, square_m, origin, x_axis, y_axis}).

@@ -67,6 +67,27 @@ TEST(Checkerboard, MapsCornersToTheirWorldPositions) {
   const CheckerboardAccuracy acc = EvaluateCheckerboard(shifted, spec);
   ASSERT_TRUE(acc.found);
   EXPECT_NEAR(acc.error_m.mean, 0.003, 0.0006);
+  // Its shape is right: one rigid motion takes the 3 mm away.
+  EXPECT_LT(acc.shape_error_m.mean, 0.0005);
+  // ... and comes back once the map is moved into the truth's frame.
+  Sim3d truth_from_map;
+  truth_from_map.rigid.translation = Eigen::Vector3d(-0.003, 0.0, 0.0);
+  const CheckerboardAccuracy aligned =
+      EvaluateCheckerboard(shifted, spec, truth_from_map);
+  ASSERT_TRUE(aligned.found);
+  EXPECT_LT(aligned.error_m.mean, 0.0005);
+  // A scale: a map 2 % small, scaled back.
+  Map small;
+  small.planes.push_back(BoardPlane(false, 0.0));
+  TexturedPlane& p = small.planes.back();
+  p.frame.origin *= 0.98;
+  p.pixels_per_meter /= 0.98;
+  Sim3d grow;
+  grow.scale = 1.0 / 0.98;
+  EXPECT_GT(EvaluateCheckerboard(small, spec).error_m.mean, 0.002);
+  // A wrong scale is a wrong shape: no rigid motion removes it.
+  EXPECT_GT(EvaluateCheckerboard(small, spec).shape_error_m.mean, 0.001);
+  EXPECT_LT(EvaluateCheckerboard(small, spec, grow).error_m.mean, 0.0005);
 }
 
 // Black surroundings right up to the board's outer squares (no quiet zone)

@@ -254,21 +254,23 @@ nlohmann::json ToJson(const CheckerboardAccuracy& acc,
   if (acc.found) {
     j["detector"] = acc.detector;
     j["error_m"] = ToJson(acc.error_m);
+    j["shape_error_m"] = ToJson(acc.shape_error_m);
   }
   return j;
 }
 
 std::string FormatTable(const CheckerboardAccuracy& acc,
                         const CheckerboardSpec& spec) {
-  char table[320];
+  char table[400];
   std::snprintf(table, sizeof(table),
                 "checkerboard %dx%d: %s in plane %d%s%s, corner error mean "
-                "%.2f mm, median %.2f mm, max %.2f mm\n",
+                "%.2f mm, median %.2f mm, max %.2f mm; after the best rigid "
+                "fit (shape) mean %.2f mm\n",
                 spec.inner_corners_x, spec.inner_corners_y,
                 acc.found ? "found" : "NOT found", acc.plane_id,
                 acc.found ? " by " : "", acc.detector.c_str(),
                 acc.error_m.mean * 1e3, acc.error_m.median * 1e3,
-                acc.error_m.max * 1e3);
+                acc.error_m.max * 1e3, acc.shape_error_m.mean * 1e3);
   return table;
 }
 
