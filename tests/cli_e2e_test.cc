@@ -320,6 +320,15 @@ TEST_F(Cli, EvalPointsOverTheBoardAndAligned) {
                  " --align se3");
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("--groundtruth"), std::string::npos) << r.output;
+  // eval checkerboard takes the same pair, checked before it reads the
+  // structure.
+  r = RunMonomap("eval checkerboard " + map.string() + " --structure " +
+                 yaml.string() + " --align sim3-poses");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("eval checkerboard: --align sim3-poses needs "
+                          "--groundtruth"),
+            std::string::npos)
+      << r.output;
 }
 
 TEST_F(Cli, EvalStructurePrintsTheTableAndWritesJson) {

@@ -5,10 +5,8 @@
 
 #include "monomap/eval/checkerboard_accuracy.h"
 #include "monomap/eval/report_json.h"
-#include "monomap/eval/trajectory_metrics.h"
 #include "monomap/exe/eval_commands.h"
 #include "monomap/io/map_format.h"
-#include "monomap/io/trajectory_io.h"
 #include "monomap/util/error.h"
 
 namespace monomap {
@@ -17,26 +15,18 @@ namespace {
 
 struct CheckerboardArgs {
   std::string map_dir, structure, json;
-  std::string align = "none", groundtruth;
+  AlignmentArgs alignment;
 };
 
 void RunEvalCheckerboard(const CheckerboardArgs& a) {
-  if ((a.align != "none") != !a.groundtruth.empty()) {
-    throw OptionsError(
-        "eval checkerboard: --align and --groundtruth go together");
-  }
   const Map map = ReadMap(a.map_dir);
+  const Sim3d truth_from_map =
+      TruthFromMap("eval checkerboard", a.alignment, map.trajectory);
   const CheckerboardSpec spec = ReadCheckerboardYaml(a.structure);
-  Sim3d truth_from_map;
-  if (a.align != "none") {
-    truth_from_map = AlignTrajectories(
-        map.trajectory, ReadTumTrajectory(a.groundtruth),
-        ParseAlignment(a.align == "first-pose" ? "first" : a.align));
-  }
   const CheckerboardAccuracy acc =
       EvaluateCheckerboard(map, spec, truth_from_map);
   nlohmann::json j = ToJson(acc, spec);
-  j["alignment"] = a.align;
+  j["alignment"] = a.alignment.align;
   PrintOrWrite(j, FormatTable(acc, spec), a.json);
   if (!acc.found) throw StageError("checkerboard not found in any texture");
 }
@@ -53,13 +43,7 @@ void RegisterEvalCheckerboardCommand(CLI::App* eval) {
   cmd->add_option("--structure", a->structure,
                   "Ground-truth structure YAML with a 'chessboard' entry")
       ->required();
-  cmd->add_option("--align", a->align,
-                  "Move the corners into the ground truth's frame first: "
-                  "none, first-pose, se3, sim3 or sim3-poses (the map's "
-                  "trajectory aligned to --groundtruth)")
-      ->capture_default_str();
-  cmd->add_option("--groundtruth", a->groundtruth,
-                  "Ground-truth trajectory (TUM) for --align");
+  AddAlignmentOptions(cmd, &a->alignment);
   cmd->add_option("--json", a->json, "Write the figures as JSON");
   cmd->callback([a]() { RunEvalCheckerboard(*a); });
 }

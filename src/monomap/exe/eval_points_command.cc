@@ -12,7 +12,6 @@
 #include "monomap/exe/eval_commands.h"
 #include "monomap/io/map_format.h"
 #include "monomap/io/ply.h"
-#include "monomap/io/trajectory_io.h"
 #include "monomap/util/error.h"
 
 namespace monomap {
@@ -21,7 +20,7 @@ namespace {
 
 struct PointArgs {
   std::string map_dir, plane_yaml, surface_ply, json;
-  std::string align = "none", groundtruth;
+  AlignmentArgs alignment;
   int plane_label = kAllLandmarks;  // -1: points on no plane
   bool largest_plane = false;
   bool over_board = false;  // only points over the YAML's chessboard
@@ -44,10 +43,9 @@ std::vector<Eigen::Vector3d> OverBoard(const std::vector<Eigen::Vector3d>& xs,
 // the alignment of its trajectory (a monocular map's frame and scale are
 // the odometry's): scaled (ScaledMap), then moved rigidly.
 void AlignToGroundTruth(const PointArgs& a, Map* map) {
-  if (a.align == "none") return;
-  const Sim3d gt_from_map = AlignTrajectories(
-      map->trajectory, ReadTumTrajectory(a.groundtruth),
-      ParseAlignment(a.align == "first-pose" ? "first" : a.align));
+  const Sim3d gt_from_map =
+      TruthFromMap("eval points", a.alignment, map->trajectory);
+  if (a.alignment.align == "none") return;
   *map = ScaledMap(*map, gt_from_map.scale);
   for (Landmark& l : map->landmarks) {
     l.x_in_world = gt_from_map.rigid * l.x_in_world;
@@ -63,9 +61,6 @@ void CheckPointArgs(const PointArgs& a) {
   }
   if (a.over_board && a.plane_yaml.empty()) {
     throw OptionsError("eval points: --over-board needs --plane");
-  }
-  if ((a.align != "none") != !a.groundtruth.empty()) {
-    throw OptionsError("eval points: --align and --groundtruth go together");
   }
 }
 
@@ -94,7 +89,7 @@ void RunEvalPoints(const PointArgs& a) {
   nlohmann::json j = ToJson(acc);
   j["plane_label"] = label;
   j["over_board"] = a.over_board;
-  j["alignment"] = a.align;
+  j["alignment"] = a.alignment.align;
   PrintOrWrite(j, FormatTable(acc), a.json);
 }
 
@@ -117,13 +112,7 @@ void RegisterEvalPointsCommand(CLI::App* eval) {
   cmd->add_flag("--over-board", a->over_board,
                 "Evaluate only points over the chessboard of the --plane YAML "
                 "(its squares, at any height)");
-  cmd->add_option("--align", a->align,
-                  "Move the map into the ground truth's frame first: none, "
-                  "first-pose, se3, sim3 or sim3-poses (its trajectory "
-                  "aligned to --groundtruth)")
-      ->capture_default_str();
-  cmd->add_option("--groundtruth", a->groundtruth,
-                  "Ground-truth trajectory (TUM) for --align");
+  AddAlignmentOptions(cmd, &a->alignment);
   cmd->add_option("--json", a->json, "Write the figures as JSON");
   cmd->callback([a]() { RunEvalPoints(*a); });
 }

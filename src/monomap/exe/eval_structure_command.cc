@@ -11,7 +11,6 @@
 #include "monomap/exe/eval_commands.h"
 #include "monomap/io/feature_table.h"
 #include "monomap/io/map_format.h"
-#include "monomap/io/trajectory_io.h"
 #include "monomap/util/error.h"
 
 namespace monomap {
@@ -19,21 +18,10 @@ namespace monomap {
 namespace {
 
 struct StructureArgs {
-  std::string map_dir, structure_dir, align = "none", groundtruth, json;
+  std::string map_dir, structure_dir, json;
+  AlignmentArgs alignment;
   StructureAccuracyOptions options;  // the project's matching thresholds
 };
-
-void CheckAlignmentArgs(const StructureArgs& a) {
-  const bool aligned = a.align != "none";
-  if (aligned && a.groundtruth.empty()) {
-    throw OptionsError("eval structure: --align " + a.align +
-                       " needs --groundtruth");
-  }
-  if (!aligned && !a.groundtruth.empty()) {
-    throw OptionsError(
-        "eval structure: --groundtruth is only used with --align");
-  }
-}
 
 // Relative point errors divide by each landmark's mean depth, which
 // points.ply does not hold: recompute it from the feature table. Returns
@@ -55,16 +43,11 @@ bool SetDepthsFromFeatures(const std::string& map_dir, Map* map) {
 }
 
 void RunEvalStructure(const StructureArgs& a) {
-  CheckAlignmentArgs(a);
   Map map = ReadMap(a.map_dir);
+  const Sim3d truth_from_map =
+      TruthFromMap("eval structure", a.alignment, map.trajectory);
   const Map truth = ReadMap(a.structure_dir);
   const bool have_features = SetDepthsFromFeatures(a.map_dir, &map);
-  Sim3d truth_from_map;
-  if (a.align != "none") {
-    truth_from_map = AlignTrajectories(
-        map.trajectory, ReadTumTrajectory(a.groundtruth),
-        ParseAlignment(a.align == "first-pose" ? "first" : a.align));
-  }
   // gt ~ scale * R * x + t: scale the map, then move it rigidly.
   if (truth_from_map.scale != 1.0) {
     map = ScaledMap(map, truth_from_map.scale);
@@ -72,15 +55,16 @@ void RunEvalStructure(const StructureArgs& a) {
   const StructureAccuracy acc =
       EvaluateStructure(map, truth, truth_from_map.rigid, a.options);
   nlohmann::json j = ToJson(acc);
-  j["alignment"] = a.align;
+  j["alignment"] = a.alignment.align;
   j["alignment_scale"] = truth_from_map.scale;
   j["relative_error_depth"] = have_features
                                   ? "mean_distance_to_observing_cameras"
                                   : "distance_to_nearest_camera";
   j["options"] = ToJson(a.options);
-  PrintOrWrite(
-      j, "structure accuracy (alignment " + a.align + ")\n" + FormatTable(acc),
-      a.json);
+  PrintOrWrite(j,
+               "structure accuracy (alignment " + a.alignment.align + ")\n" +
+                   FormatTable(acc),
+               a.json);
 }
 
 }  // namespace
@@ -97,21 +81,7 @@ void RegisterEvalStructureCommand(CLI::App* eval) {
                   "Ground-truth structure as a map directory (the "
                   "simulator writes DATASET/structure)")
       ->required();
-  cmd->add_option("--align", a->align,
-                  "none: the map is in the truth's frame (the simulator's "
-                  "odometry starts at the true pose); first-pose: align "
-                  "the map's first trajectory pose to --groundtruth; "
-                  "se3 / sim3: the rigid / similarity transform that best "
-                  "fits the map's trajectory positions to --groundtruth "
-                  "(sim3 removes the scale error the odometry gives the "
-                  "map); sim3-poses: the similarity with its rotation from "
-                  "the trajectory's orientations (determined also for a "
-                  "straight drive)")
-      ->check(
-          CLI::IsMember({"none", "first-pose", "se3", "sim3", "sim3-poses"}))
-      ->capture_default_str();
-  cmd->add_option("--groundtruth", a->groundtruth,
-                  "Ground-truth trajectory (TUM) for --align");
+  AddAlignmentOptions(cmd, &a->alignment);
   cmd->add_option("--json", a->json, "Write the figures as JSON");
   cmd->callback([a]() { RunEvalStructure(*a); });
 }
