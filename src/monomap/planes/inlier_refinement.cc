@@ -133,7 +133,8 @@ void RefineOnePlane(const PlaneSegment& segment, int neighbours,
   for (size_t i = 0; i < members.size(); ++i) {
     Landmark& l = (*landmarks)[members[i]];
     const Eigen::Vector3d step =
-        excess[i] * MoveDirection(l.covariance_m2_per_px2, segment.plane.normal);
+        excess[i] *
+        MoveDirection(l.covariance_m2_per_px2, segment.plane.normal);
     l.x_in_world -= step;
     moves->push_back(step.norm());
     if (l.mean_depth_m > 0) {
@@ -153,7 +154,8 @@ InlierRefinementReport RefineInliersOnPlanes(
   report.enabled = options.enabled;
   if (!options.enabled) return report;
   std::unordered_map<int, size_t> segment_of_id;
-  for (size_t s = 0; s < segments.size(); ++s) segment_of_id[segments[s].id] = s;
+  for (size_t s = 0; s < segments.size(); ++s)
+    segment_of_id[segments[s].id] = s;
   std::vector<std::vector<int>> members(segments.size());
   for (int i = 0; i < static_cast<int>(landmarks->size()); ++i) {
     const Landmark& l = (*landmarks)[i];

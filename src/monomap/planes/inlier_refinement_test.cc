@@ -93,8 +93,8 @@ TEST(InlierRefinement, NoisyInliersComeCloseToTheirPlaneAlongTheirRays) {
   for (size_t i = 0; i < before.size(); ++i) {
     const Eigen::Vector3d camera(patch.truth[i].x(), -2.0, 1.2);
     const Eigen::Vector3d ray = (patch.truth[i] - camera).normalized();
-    const Eigen::Vector3d step = patch.landmarks[i].x_in_world -
-                                 before[i].x_in_world;
+    const Eigen::Vector3d step =
+        patch.landmarks[i].x_in_world - before[i].x_in_world;
     EXPECT_LT((step - step.dot(ray) * ray).norm(), 0.05 * step.norm() + 1e-9);
   }
   EXPECT_GT(report.median_move_m, 0.005);
@@ -110,8 +110,7 @@ TEST(InlierRefinement, ABendTheMapMeasuresIsKeptWhereOnePlaneWouldFlattenIt) {
   for (Landmark& l : flattened) {
     l.x_in_world = segment.plane.Project(l.x_in_world);
   }
-  RefineInliersOnPlanes(InlierRefinementOptions(), {segment},
-                        &patch.landmarks);
+  RefineInliersOnPlanes(InlierRefinementOptions(), {segment}, &patch.landmarks);
   const double local = MedianHeightError(patch.landmarks, patch.truth);
   const double global = MedianHeightError(flattened, patch.truth);
   EXPECT_LT(local, 0.3 * global) << local << " against " << global;
@@ -139,7 +138,8 @@ TEST(InlierRefinement, EachPlaneUsesOnlyItsOwnInliersAndOutliersStay) {
   // The step's points settle on the step, not on the floor below.
   const double step_after =
       MedianHeightError(landmarks, step.truth, floor.truth.size());
-  EXPECT_LT(step_after, 0.5 * step_before) << step_before << " -> " << step_after;
+  EXPECT_LT(step_after, 0.5 * step_before)
+      << step_before << " -> " << step_after;
   EXPECT_EQ(landmarks.back().x_in_world, outlier.x_in_world);
 }
 

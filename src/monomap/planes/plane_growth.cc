@@ -795,9 +795,6 @@ std::vector<View> LoadViews(const PlaneGrowthOptions& o, const Camera& camera,
   return views;
 }
 
-// Checks the hypotheses against the images, most landmarks first (see
-// GrowPlanePolygons); confirmed ones join *segments and hide what lies
-// behind them from the next.
 constexpr double kNoGain = -10.0;  // a cell OffsetNccGain could not judge
 
 // Median distance (m) from the views to the centroid of a segment's
@@ -820,7 +817,8 @@ double OffsetNccGain(const PlaneGrowthOptions& o, const PlaneSegment& seg,
                      const std::vector<const PlaneSegment*>& occluders,
                      const std::vector<View>& views,
                      const DistortedProjector& projector, double shift) {
-  const PlaneSegment nearer = Shifted(seg, -shift), farther = Shifted(seg, shift);
+  const PlaneSegment nearer = Shifted(seg, -shift),
+                     farther = Shifted(seg, shift);
   const CellJudge at(o, seg, g.grid, views, occluders, projector);
   const CellJudge at_nearer(o, nearer, g.grid, views, occluders, projector);
   const CellJudge at_farther(o, farther, g.grid, views, occluders, projector);
@@ -844,6 +842,9 @@ double OffsetNccGain(const PlaneGrowthOptions& o, const PlaneSegment& seg,
   return gain.empty() ? kNoGain : Median(gain);
 }
 
+// Checks the hypotheses against the images, most landmarks first (see
+// GrowPlanePolygons); confirmed ones join *segments and hide what lies
+// behind them from the next.
 void ConfirmHypotheses(
     const PlaneGrowthOptions& o, const std::vector<View>& views,
     const DistortedProjector& projector,
@@ -861,8 +862,8 @@ void ConfirmHypotheses(
     PlaneSegment seg = hypotheses[i];
     HypothesisStats h;
     h.inliers = static_cast<int>(seg.inlier_ids.size());
-    const SegmentGrid g = PrepareGrid(o, seg, views, projector,
-                                      world_from_cam, landmarks, track_by_id);
+    const SegmentGrid g = PrepareGrid(o, seg, views, projector, world_from_cam,
+                                      landmarks, track_by_id);
     std::vector<const PlaneSegment*> occluders;
     for (const PlaneSegment& other : *segments) {
       if (other.polygon.size() >= 3) occluders.push_back(&other);
@@ -893,20 +894,21 @@ void ConfirmHypotheses(
   }
 }
 
-}  // namespace
-
 // Each view's exposure gain relative to the others, from the tracks: a
 // feature's surroundings (a box mean around it) brighten and darken with
 // the frames that see it, so a view's gain is the median over its features
 // of their brightness there over their median across the views. Views
-// with too few features keep 1. Returns the smallest and largest gain.
-std::pair<double, double> EstimateExposureGains(const std::vector<Track>& tracks,
-                                                std::vector<View>* views) {
-  constexpr int kHalfBox = 4;        // 9 x 9 px: robust to sub-pixel drift
-  constexpr int kMinFeatures = 20;   // per view, for a gain
+// with too few features keep 1. Returns the smallest and largest gain of
+// a view.
+std::pair<double, double> EstimateExposureGains(
+    const std::vector<Track>& tracks, std::vector<View>* views) {
+  constexpr int kHalfBox = 4;       // 9 x 9 px: robust to sub-pixel drift
+  constexpr int kMinFeatures = 20;  // per view, for a gain
   constexpr double kMinBrightness = 10.0;  // darker: noise, not exposure
   std::unordered_map<int, size_t> view_of_frame;
-  for (size_t v = 0; v < views->size(); ++v) view_of_frame[(*views)[v].frame] = v;
+  for (size_t v = 0; v < views->size(); ++v) {
+    view_of_frame[(*views)[v].frame] = v;
+  }
   std::vector<std::vector<double>> ratios(views->size());
   std::vector<std::pair<size_t, double>> seen;
   for (const Track& t : tracks) {
@@ -928,16 +930,20 @@ std::pair<double, double> EstimateExposureGains(const std::vector<Track>& tracks
     if (median < kMinBrightness) continue;
     for (const auto& s : seen) ratios[s.first].push_back(s.second / median);
   }
-  double lo = 1.0, hi = 1.0;
+  double lo = 1.0, hi = 1.0;  // every view's gain, estimated or kept at 1
   for (size_t v = 0; v < views->size(); ++v) {
-    if (static_cast<int>(ratios[v].size()) < kMinFeatures) continue;
-    const double gain = Median(std::move(ratios[v]));
-    (*views)[v].exposure_gain = gain;
-    lo = std::min(lo, gain);
-    hi = std::max(hi, gain);
+    if (static_cast<int>(ratios[v].size()) >= kMinFeatures) {
+      (*views)[v].exposure_gain = Median(std::move(ratios[v]));
+    }
+    lo = v == 0 ? (*views)[v].exposure_gain
+                : std::min(lo, (*views)[v].exposure_gain);
+    hi = v == 0 ? (*views)[v].exposure_gain
+                : std::max(hi, (*views)[v].exposure_gain);
   }
   return {lo, hi};
 }
+
+}  // namespace
 
 PlaneGrowthReport GrowPlanePolygons(
     const PlaneGrowthOptions& options, const Camera& camera,
