@@ -121,10 +121,9 @@ void AddLensOptions(CLI::App* cmd, IntrinsicsRefinementOptions* o) {
 
 void AddPointTrustOptions(CLI::App* cmd, PointTrustOptions* o,
                           InlierRefinementOptions* refinement) {
-  cmd->add_flag("--raw-points", [refinement](int64_t) {
-    refinement->enabled = false;
-  }, "Export plane inliers where triangulation put them, not moved to "
-     "their plane's local offset");
+  cmd->add_flag("!--raw-points", refinement->enabled,
+                "Export plane inliers where triangulation put them, not "
+                "moved to their plane's local offset");
   cmd->add_flag("--keep-all-points", o->keep_all,
                 "Export every triangulated point to points.ply, also those "
                 "the map does not trust (the report still counts them)");

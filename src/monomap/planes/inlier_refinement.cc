@@ -154,8 +154,9 @@ InlierRefinementReport RefineInliersOnPlanes(
   report.enabled = options.enabled;
   if (!options.enabled) return report;
   std::unordered_map<int, size_t> segment_of_id;
-  for (size_t s = 0; s < segments.size(); ++s)
+  for (size_t s = 0; s < segments.size(); ++s) {
     segment_of_id[segments[s].id] = s;
+  }
   std::vector<std::vector<int>> members(segments.size());
   for (int i = 0; i < static_cast<int>(landmarks->size()); ++i) {
     const Landmark& l = (*landmarks)[i];

@@ -89,7 +89,7 @@ struct PlaneGrowthOptions {
   // other views before the plain test: auto-exposure brightens and darkens
   // whole frames, which the test would otherwise take for a surface that
   // differs between the views. Gains from the tracked features
-  // (EstimateExposureGains).
+  // (EstimateExposureGains in plane_growth.cc).
   bool compensate_exposure = true;
   // Plain cells may extend at most this many cells from texture evidence.
   int max_plain_run = 8;
@@ -143,8 +143,9 @@ struct PlaneGrowthOptions {
   // Far ahead, with little parallax, a plane some cm off correlates as
   // well as the surface, or better (0: no such test).
   double hypothesis_offset_depth_fraction = 0.01;
-  // See hypothesis_offset_depth_fraction. Smooth blob texture at 2-3 m
-  // gains only about 0.02 over 2.5 cm, so the bar is the sign.
+  // See hypothesis_offset_depth_fraction. A true plane of smooth texture
+  // gains little over so small a move, so the bar is the sign
+  // (docs/design-notes.md, "Planes").
   double hypothesis_min_offset_ncc_gain = 0.0;
   // Growth passes: each regrows every segment from its fitted polygon,
   // hidden by the others as the previous pass grew them (a wall below a
