@@ -102,6 +102,9 @@ void AddLensOptions(CLI::App* cmd, IntrinsicsRefinementOptions* o) {
                 "With --refine-intrinsics: also try the principal point");
   cmd->add_flag("--lens-fix-radial{false}", lens.refine_radial,
                 "With --refine-intrinsics: keep the given k1, k2");
+  cmd->add_flag("--lens-no-halves-check{false}", lens.check_halves,
+                "With --refine-intrinsics: trust a group without checking "
+                "that the first and second half of the frames agree on it");
   cmd->add_option("--lens-focal-sigma", lens.focal_sigma_fraction,
                   "Prior sigma of the focal length (fraction of fx)")
       ->check(CLI::PositiveNumber)

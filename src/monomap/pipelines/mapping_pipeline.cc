@@ -324,6 +324,22 @@ nlohmann::json LensJson(const std::array<double, kLensSize>& v) {
           {"cy", v[kLensCy]}, {"k1", v[kLensK1]}, {"k2", v[kLensK2]}};
 }
 
+// The trials on each half of the frames (check_halves) and, per group, how
+// far apart they are in combined sigmas (-1: not compared).
+nlohmann::json HalvesJson(const IntrinsicsRefinementReport& r) {
+  if (!r.halves_checked) return nullptr;
+  return {{"first",
+           {{"candidate", LensJson(r.halves_candidate[0])},
+            {"posterior_std", LensJson(r.halves_std[0])}}},
+          {"second",
+           {{"candidate", LensJson(r.halves_candidate[1])},
+            {"posterior_std", LensJson(r.halves_std[1])}}},
+          {"sigmas_apart",
+           {{"focal", r.halves_sigmas[kGroupFocal]},
+            {"principal_point", r.halves_sigmas[kGroupPrincipalPoint]},
+            {"radial", r.halves_sigmas[kGroupRadial]}}}};
+}
+
 // Lens self-calibration: refined or not and why, before and after, prior
 // and marginal standard deviations.
 nlohmann::json IntrinsicsJson(const IntrinsicsRefinementReport& r) {
@@ -339,6 +355,7 @@ nlohmann::json IntrinsicsJson(const IntrinsicsRefinementReport& r) {
           {"candidate", LensJson(r.candidate)},
           {"prior_std", LensJson(r.prior_std)},
           {"posterior_std", LensJson(r.posterior_std)},
+          {"halves", HalvesJson(r)},
           {"covariance_seconds", r.covariance_seconds}};
 }
 

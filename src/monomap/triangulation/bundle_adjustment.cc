@@ -836,6 +836,58 @@ bool AdjustOnce(const Camera& camera, const std::vector<Track>& tracks,
   return true;
 }
 
+// The lens trial on frames [first, last) alone: the tracks cut to those
+// frames (kept with >= 3 observations there) and their landmarks, on
+// copies. Returns the trial's values and marginal standard deviations.
+IntrinsicsRefinementReport TrialOnFrames(
+    const Camera& camera, const std::vector<Track>& tracks,
+    const BundleAdjustmentOptions& options,
+    const std::array<bool, kNumLensGroups>& free_groups, int first, int last,
+    std::vector<Rigid3d> world_from_cam,
+    const std::vector<Landmark>& landmarks) {
+  std::vector<Track> cut;
+  std::unordered_map<FeatureId, bool> kept;
+  for (const Track& t : tracks) {
+    Track c{t.id, {}};
+    for (const Observation& o : t.observations) {
+      if (o.frame >= first && o.frame < last) c.observations.push_back(o);
+    }
+    if (c.observations.size() < 3) continue;
+    kept[t.id] = true;
+    cut.push_back(std::move(c));
+  }
+  std::vector<Landmark> cut_landmarks;
+  for (const Landmark& l : landmarks) {
+    if (kept.count(l.id)) cut_landmarks.push_back(l);
+  }
+  IntrinsicsRefinementReport lens;
+  lens.before = camera;
+  BundleAdjustmentReport report;
+  AdjustOnce(camera, cut, options, free_groups, &lens, &world_from_cam,
+             &cut_landmarks, &report);
+  return lens;
+}
+
+// check_halves: the trials on each half of the frames, into *lens for the
+// judgement of the whole trial (JudgeLensGroups).
+void TrialOnHalves(const Camera& camera, const std::vector<Track>& tracks,
+                   const BundleAdjustmentOptions& options,
+                   const std::array<bool, kNumLensGroups>& free_groups,
+                   const std::vector<Rigid3d>& world_from_cam,
+                   const std::vector<Landmark>& landmarks,
+                   IntrinsicsRefinementReport* lens) {
+  const int n = static_cast<int>(world_from_cam.size());
+  const int bounds[3] = {0, n / 2, n};
+  for (int h = 0; h < 2; ++h) {
+    const IntrinsicsRefinementReport half =
+        TrialOnFrames(camera, tracks, options, free_groups, bounds[h],
+                      bounds[h + 1], world_from_cam, landmarks);
+    lens->halves_candidate[h] = half.candidate;
+    lens->halves_std[h] = half.posterior_std;
+  }
+  lens->halves_checked = true;
+}
+
 }  // namespace
 
 BundleAdjustmentReport BundleAdjust(const Camera& camera,
@@ -855,10 +907,14 @@ BundleAdjustmentReport BundleAdjust(const Camera& camera,
     // Trial with the chosen groups free under their prior; kept if every
     // group passes the judgement, else adjusted again without the others.
     lens.attempted = true;
-    done = AdjustOnce(
-        camera, tracks, options,
-        {io.refine_focal, io.refine_principal_point, io.refine_radial}, &lens,
-        world_from_cam, landmarks, &report);
+    const std::array<bool, kNumLensGroups> wanted = {
+        io.refine_focal, io.refine_principal_point, io.refine_radial};
+    if (io.check_halves) {
+      TrialOnHalves(camera, tracks, options, wanted, *world_from_cam,
+                    *landmarks, &lens);
+    }
+    done = AdjustOnce(camera, tracks, options, wanted, &lens, world_from_cam,
+                      landmarks, &report);
   }
   if (!done) {
     AdjustOnce(camera, tracks, options, lens.group_refined, nullptr,

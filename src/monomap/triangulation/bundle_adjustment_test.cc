@@ -498,6 +498,11 @@ TEST(BundleAdjustmentTest, SelfCalibrationRecoversAPerturbedRadialLens) {
   EXPECT_NEAR(lens.after.distortion[0], scene.camera.distortion[0], 0.005);
   EXPECT_GT(lens.posterior_std[kLensK1], 0.0);
   EXPECT_LT(lens.posterior_std[kLensK1], 0.5 * lens.prior_std[kLensK1]);
+  // One lens over the sequence: its two halves agree on k1.
+  EXPECT_TRUE(lens.halves_checked);
+  EXPECT_GE(lens.halves_sigmas[kGroupRadial], 0.0);
+  EXPECT_LT(lens.halves_sigmas[kGroupRadial],
+            refine.intrinsics.max_halves_sigmas);
   // The wrong lens costs a factor ~10 in points and ~25 in rotation; the
   // refined one comes back to within ~30% of the true lens (2.7 vs 3.5 mm,
   // 0.032 vs 0.053 deg): not the 10% on this small scene.
@@ -505,6 +510,55 @@ TEST(BundleAdjustmentTest, SelfCalibrationRecoversAPerturbedRadialLens) {
   EXPECT_LT(refined.median_point_m, 1.4 * with_true.median_point_m);
   EXPECT_LT(refined.mean_rotation_deg, 1.9 * with_true.mean_rotation_deg);
   EXPECT_LT(refined.mean_rotation_deg, 0.1 * with_wrong.mean_rotation_deg);
+}
+
+// A lens that is not the same over the sequence (here k1 30 % weaker from
+// the middle frame on, as a model error would look): the whole sequence
+// still gives k1 a small marginal std, but the trials on each half disagree
+// by many of their sigmas, so the check keeps the given lens and says why.
+TEST(BundleAdjustmentTest, SelfCalibrationKeepsAGroupItsHalvesDisagreeOn) {
+  const testing::TestScene scene = NoisyScene(500, 13);
+  Camera second_lens = scene.camera;
+  second_lens.distortion[0] *= 0.7;
+  const int middle = static_cast<int>(scene.world_from_cam.size()) / 2;
+  std::vector<Track> tracks = scene.tracks;
+  for (Track& t : tracks) {
+    for (Observation& o : t.observations) {
+      if (o.frame < middle) continue;
+      o.px = second_lens.ImageFromCam(
+          scene.camera.NormalizedFromImage(o.px).homogeneous());
+    }
+  }
+  BundleAdjustmentOptions refine;
+  refine.intrinsics.enabled = true;
+  BundleAdjustmentReport checked, unchecked;
+  AdjustWithLens(scene, scene.camera, tracks, scene.world_from_cam, refine,
+                 &checked);
+  refine.intrinsics.check_halves = false;
+  AdjustWithLens(scene, scene.camera, tracks, scene.world_from_cam, refine,
+                 &unchecked);
+  const IntrinsicsRefinementReport& lens = checked.intrinsics;
+  std::printf(
+      "k1 halves %.4f / %.4f (std %.5f / %.5f), %.1f sigmas apart\n%s\n",
+      lens.halves_candidate[0][kLensK1], lens.halves_candidate[1][kLensK1],
+      lens.halves_std[0][kLensK1], lens.halves_std[1][kLensK1],
+      lens.halves_sigmas[kGroupRadial], lens.reason.c_str());
+  // Without the check the std test alone trusts the compromise.
+  EXPECT_TRUE(unchecked.intrinsics.group_refined[kGroupRadial]);
+  EXPECT_FALSE(unchecked.intrinsics.halves_checked);
+  // With it, each half finds its own k1 and the lens is kept.
+  ASSERT_TRUE(lens.halves_checked);
+  EXPECT_NEAR(lens.halves_candidate[0][kLensK1], scene.camera.distortion[0],
+              0.01);
+  EXPECT_NEAR(lens.halves_candidate[1][kLensK1], second_lens.distortion[0],
+              0.01);
+  EXPECT_GT(lens.halves_sigmas[kGroupRadial],
+            refine.intrinsics.max_halves_sigmas);
+  EXPECT_FALSE(lens.group_refined[kGroupRadial]);
+  EXPECT_NE(lens.reason.find("radial distortion kept: the two halves of the "
+                             "frames disagree"),
+            std::string::npos);
+  EXPECT_EQ(checked.camera.distortion, scene.camera.distortion);
 }
 
 // The trial kept `group` because the data did not shrink the std of its
@@ -630,6 +684,8 @@ TEST(BundleAdjustmentTest, SelfCalibrationOptionsChecked) {
   EXPECT_THROW(options.Check(), OptionsError);
   options.intrinsics.refine_focal = true;
   EXPECT_NO_THROW(options.Check());
+  options.intrinsics.max_halves_sigmas = 0.0;
+  EXPECT_THROW(options.Check(), OptionsError);
 }
 
 }  // namespace

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
+#include <string>
 #include <vector>
 
 #include "monomap/util/error.h"
@@ -24,6 +26,8 @@ void IntrinsicsRefinementOptions::Check() const {
       "enabled needs at least one group "
       "(focal, principal point, radial) to refine");
   CheckOption(max_change_prior_sigmas > 0, "intrinsics.max_change_prior_sigmas",
+              "must be positive");
+  CheckOption(max_halves_sigmas > 0, "intrinsics.max_halves_sigmas",
               "must be positive");
 }
 
@@ -83,59 +87,116 @@ const char* GroupName(int group) {
 
 }  // namespace
 
+namespace {
+
+// The halves' evidence on a group: the largest ratio of a half's marginal
+// std to the prior's (infinite without a std) in *half_ratio, and the
+// largest difference of their values in combined sigmas (returned), with
+// its parameter in *worst.
+double HalvesSigmas(const IntrinsicsRefinementReport& r,
+                    const std::vector<int>& parameters, double* half_ratio,
+                    int* worst) {
+  double largest = 0.0;
+  *half_ratio = 0.0;
+  *worst = parameters.front();
+  for (int k : parameters) {
+    const double sa = r.halves_std[0][k], sb = r.halves_std[1][k];
+    if (!(sa > 0.0 && sb > 0.0)) {
+      *half_ratio = std::numeric_limits<double>::infinity();
+      return -1.0;
+    }
+    *half_ratio = std::max(*half_ratio, std::max(sa, sb) / r.prior_std[k]);
+    const double sigmas =
+        std::abs(r.halves_candidate[0][k] - r.halves_candidate[1][k]) /
+        std::hypot(sa, sb);
+    if (sigmas > largest) {
+      largest = sigmas;
+      *worst = k;
+    }
+  }
+  return largest;
+}
+
+// Whether group g is trusted, and one sentence saying why.
+bool JudgeLensGroup(const IntrinsicsRefinementOptions& options,
+                    bool posterior_ok, int g,
+                    IntrinsicsRefinementReport* report, std::string* why) {
+  const std::vector<int> parameters =
+      GroupParameters(static_cast<LensGroup>(g), options.shared_focal);
+  const std::array<double, kLensSize> given = LensParameters(report->before);
+  // Worst parameter of the group: largest posterior/prior ratio, largest
+  // change in prior sigmas.
+  double ratio = 0.0, change = 0.0;
+  for (int k : parameters) {
+    const double prior = report->prior_std[k];
+    ratio = std::max(ratio, report->posterior_std[k] / prior);
+    change =
+        std::max(change, std::abs(report->candidate[k] - given[k]) / prior);
+  }
+  int worst = parameters.front();
+  double half_ratio = 0.0;
+  const double halves =
+      report->halves_checked
+          ? HalvesSigmas(*report, parameters, &half_ratio, &worst)
+          : -1.0;
+  report->halves_sigmas[g] = halves;
+  char sentence[240];
+  bool trusted = false;
+  const bool wanted[] = {options.refine_focal, options.refine_principal_point,
+                         options.refine_radial};
+  if (!wanted[g]) {
+    std::snprintf(sentence, sizeof(sentence), "%s kept: not refined by option.",
+                  GroupName(g));
+  } else if (!posterior_ok) {
+    std::snprintf(sentence, sizeof(sentence),
+                  "%s kept: its covariance could not be computed (the problem "
+                  "is rank deficient).",
+                  GroupName(g));
+  } else if (ratio > options.max_posterior_to_prior_std) {
+    std::snprintf(sentence, sizeof(sentence),
+                  "%s kept: not constrained by the data (std %.2f of the "
+                  "prior's, limit %.2f).",
+                  GroupName(g), ratio, options.max_posterior_to_prior_std);
+  } else if (change > options.max_change_prior_sigmas) {
+    std::snprintf(sentence, sizeof(sentence),
+                  "%s kept: it moved %.1f prior sigmas (limit %.1f), "
+                  "implausible.",
+                  GroupName(g), change, options.max_change_prior_sigmas);
+  } else if (half_ratio > options.max_posterior_to_prior_std) {
+    std::snprintf(sentence, sizeof(sentence),
+                  "%s kept: a half of the frames alone does not constrain it "
+                  "(std %.2f of the prior's, limit %.2f).",
+                  GroupName(g), half_ratio, options.max_posterior_to_prior_std);
+  } else if (halves > options.max_halves_sigmas) {
+    std::snprintf(sentence, sizeof(sentence),
+                  "%s kept: the two halves of the frames disagree (%.5g vs "
+                  "%.5g, %.1f sigmas, limit %.1f).",
+                  GroupName(g), report->halves_candidate[0][worst],
+                  report->halves_candidate[1][worst], halves,
+                  options.max_halves_sigmas);
+  } else {
+    trusted = true;
+    std::snprintf(sentence, sizeof(sentence),
+                  "%s refined: std %.2f of the prior's, moved %.1f prior "
+                  "sigmas%s.",
+                  GroupName(g), ratio, change,
+                  report->halves_checked ? ", the halves agree" : "");
+  }
+  *why = sentence;
+  return trusted;
+}
+
+}  // namespace
+
 void JudgeLensGroups(const IntrinsicsRefinementOptions& options,
                      bool posterior_ok, IntrinsicsRefinementReport* report) {
-  const bool shared = options.shared_focal;
-  const std::array<double, kLensSize> given = LensParameters(report->before);
   report->reason.clear();
-  const std::array<bool, kNumLensGroups> wanted = {
-      options.refine_focal, options.refine_principal_point,
-      options.refine_radial};
   for (int g = 0; g < kNumLensGroups; ++g) {
-    // Worst parameter of the group: largest posterior/prior ratio, largest
-    // change in prior sigmas.
-    double ratio = 0.0, change = 0.0;
-    for (int k : GroupParameters(static_cast<LensGroup>(g), shared)) {
-      const double prior = report->prior_std[k];
-      ratio = std::max(ratio, report->posterior_std[k] / prior);
-      change =
-          std::max(change, std::abs(report->candidate[k] - given[k]) / prior);
-    }
-    char sentence[200];
-    if (!wanted[g]) {
-      report->group_refined[g] = false;
-      std::snprintf(sentence, sizeof(sentence),
-                    "%s kept: not refined by "
-                    "option. ",
-                    GroupName(g));
-    } else if (!posterior_ok) {
-      report->group_refined[g] = false;
-      std::snprintf(sentence, sizeof(sentence),
-                    "%s kept: its covariance could not be computed (the "
-                    "problem is rank deficient). ",
-                    GroupName(g));
-    } else if (ratio > options.max_posterior_to_prior_std) {
-      report->group_refined[g] = false;
-      std::snprintf(sentence, sizeof(sentence),
-                    "%s kept: not constrained by the data (std %.2f of the "
-                    "prior's, limit %.2f). ",
-                    GroupName(g), ratio, options.max_posterior_to_prior_std);
-    } else if (change > options.max_change_prior_sigmas) {
-      report->group_refined[g] = false;
-      std::snprintf(sentence, sizeof(sentence),
-                    "%s kept: it moved %.1f prior sigmas (limit %.1f), "
-                    "implausible. ",
-                    GroupName(g), change, options.max_change_prior_sigmas);
-    } else {
-      report->group_refined[g] = true;
-      std::snprintf(sentence, sizeof(sentence),
-                    "%s refined: std %.2f of the prior's, moved %.1f prior "
-                    "sigmas. ",
-                    GroupName(g), ratio, change);
-    }
-    report->reason += sentence;
+    std::string why;
+    report->group_refined[g] =
+        JudgeLensGroup(options, posterior_ok, g, report, &why);
+    report->reason += (g == 0 ? "" : " ") + why;
   }
-  if (!report->reason.empty()) report->reason.pop_back();
 }
 
 }  // namespace monomap

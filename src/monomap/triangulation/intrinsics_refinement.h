@@ -54,6 +54,14 @@ struct IntrinsicsRefinementOptions {
   // ... and it moved at most this many prior sigmas (farther means the
   // given calibration or the adjustment is wrong: keep the given one).
   double max_change_prior_sigmas = 4.0;
+  // ... and, with check_halves, the trials on the first and on the second
+  // half of the frames alone each constrain it (the std test above) and
+  // agree on it: their values differ by at most max_halves_sigmas of their
+  // combined marginal standard deviation. The marginal std holds only if
+  // the model does (lens, odometry, tracker); halves that disagree show it
+  // does not, whatever the std says.
+  bool check_halves = true;
+  double max_halves_sigmas = 3.0;
   // Throws OptionsError naming the field if a value makes no sense.
   void Check() const;
 };
@@ -83,6 +91,14 @@ struct IntrinsicsRefinementReport {
   std::array<double, kLensSize> posterior_std = {0, 0, 0, 0, 0, 0};
   // Values after the trial adjustment.
   std::array<double, kLensSize> candidate = {0, 0, 0, 0, 0, 0};
+  // The trials on the first and the second half of the frames (check_halves;
+  // halves_checked false otherwise): their values and marginal standard
+  // deviations (-1 if not computed), and per group the largest difference
+  // of the halves in combined sigmas (-1: not compared).
+  bool halves_checked = false;
+  std::array<std::array<double, kLensSize>, 2> halves_candidate{};
+  std::array<std::array<double, kLensSize>, 2> halves_std{};
+  std::array<double, kNumLensGroups> halves_sigmas = {-1, -1, -1};
   double covariance_seconds = 0.0;
 };
 
@@ -98,8 +114,9 @@ std::array<double, kLensSize> LensPriorSigmas(
 
 // Which groups to trust, from the trial adjustment's candidate values and
 // marginal standard deviations (posterior_ok false: the covariance could
-// not be computed, nothing is trusted); groups the options do not refine
-// stay kept. Fills report->group_refined and report->reason.
+// not be computed, nothing is trusted) and, if report->halves_checked, the
+// halves' agreement; groups the options do not refine stay kept. Fills
+// report->halves_sigmas, report->group_refined and report->reason.
 void JudgeLensGroups(const IntrinsicsRefinementOptions& options,
                      bool posterior_ok, IntrinsicsRefinementReport* report);
 
