@@ -92,12 +92,13 @@ void AddBundleAdjustmentOptions(CLI::App* cmd, BundleAdjustmentOptions* o) {
 void AddLensOptions(CLI::App* cmd, IntrinsicsRefinementOptions* o) {
   IntrinsicsRefinementOptions& lens = *o;
   cmd->add_flag("--refine-intrinsics", lens.enabled,
-                "Lens self-calibration: bundle adjustment refines k1, k2 "
-                "(and with the flags below focal length, principal point) "
-                "under a prior at the given calibration, where the data "
-                "constrain them (the report says which and why)");
-  cmd->add_flag("--lens-refine-focal", lens.refine_focal,
-                "With --refine-intrinsics: also try the focal length");
+                "Lens self-calibration: bundle adjustment refines the focal "
+                "length and k1, k2 (and with the flag below the principal "
+                "point) under a prior at the given calibration, where the "
+                "data constrain them and both halves of the frames agree "
+                "(the report says which and why)");
+  cmd->add_flag("--lens-fix-focal{false}", lens.refine_focal,
+                "With --refine-intrinsics: keep the given focal length");
   cmd->add_flag("--lens-refine-principal-point", lens.refine_principal_point,
                 "With --refine-intrinsics: also try the principal point");
   cmd->add_flag("--lens-fix-radial{false}", lens.refine_radial,

@@ -492,7 +492,8 @@ TEST(BundleAdjustmentTest, SelfCalibrationRecoversAPerturbedRadialLens) {
       refined.mean_rotation_deg, lens.reason.c_str());
   EXPECT_TRUE(lens.attempted);
   EXPECT_TRUE(lens.group_refined[kGroupRadial]);
-  EXPECT_FALSE(lens.group_refined[kGroupFocal]);  // not asked for
+  EXPECT_FALSE(
+      lens.group_refined[kGroupFocal]);  // sideways motion: unconstrained
   EXPECT_EQ(lens.after.fx, wrong.fx);
   EXPECT_EQ(refined_report.camera.distortion, lens.after.distortion);
   EXPECT_NEAR(lens.after.distortion[0], scene.camera.distortion[0], 0.005);
@@ -681,6 +682,7 @@ TEST(BundleAdjustmentTest, SelfCalibrationOptionsChecked) {
   EXPECT_THROW(options.Check(), OptionsError);
   options.intrinsics.k1_sigma = 0.05;
   options.intrinsics.refine_radial = false;
+  options.intrinsics.refine_focal = false;
   EXPECT_THROW(options.Check(), OptionsError);
   options.intrinsics.refine_focal = true;
   EXPECT_NO_THROW(options.Check());

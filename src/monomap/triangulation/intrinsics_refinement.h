@@ -31,11 +31,9 @@ struct IntrinsicsRefinementOptions {
   // docs/benchmarks.md.
   bool enabled = false;
   // Groups the trial may refine (a group left out keeps the given values).
-  // Focal length and principal point are off by default: on simulated
-  // hallways their marginal std is small but they converge ~0.5% / ~5 px
-  // off the truth whatever the start (a bias the covariance cannot show);
-  // k1, k2 converge to the truth (figures: docs/benchmarks.md).
-  bool refine_focal = false;
+  // The principal point is off by default: no benchmark shows it helping
+  // (figures: docs/benchmarks.md).
+  bool refine_focal = true;
   bool refine_principal_point = false;
   bool refine_radial = true;
   // One focal length for both axes (the given fy/fx ratio is kept).
