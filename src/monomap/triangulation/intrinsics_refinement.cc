@@ -152,21 +152,20 @@ bool JudgeLensGroup(const IntrinsicsRefinementOptions& options,
                   "%s kept: its covariance could not be computed (the problem "
                   "is rank deficient).",
                   GroupName(g));
-  } else if (ratio > options.max_posterior_to_prior_std) {
-    std::snprintf(sentence, sizeof(sentence),
-                  "%s kept: not constrained by the data (std %.2f of the "
-                  "prior's, limit %.2f).",
-                  GroupName(g), ratio, options.max_posterior_to_prior_std);
+  } else if (std::max(ratio, half_ratio) > options.max_posterior_to_prior_std) {
+    // The whole sequence first, then each half alone.
+    const bool whole = ratio > options.max_posterior_to_prior_std;
+    std::snprintf(
+        sentence, sizeof(sentence),
+        "%s kept: %s (std %.2f of the prior's, limit %.2f).", GroupName(g),
+        whole ? "not constrained by the data"
+              : "a half of the frames alone does not constrain it",
+        whole ? ratio : half_ratio, options.max_posterior_to_prior_std);
   } else if (change > options.max_change_prior_sigmas) {
     std::snprintf(sentence, sizeof(sentence),
                   "%s kept: it moved %.1f prior sigmas (limit %.1f), "
                   "implausible.",
                   GroupName(g), change, options.max_change_prior_sigmas);
-  } else if (half_ratio > options.max_posterior_to_prior_std) {
-    std::snprintf(sentence, sizeof(sentence),
-                  "%s kept: a half of the frames alone does not constrain it "
-                  "(std %.2f of the prior's, limit %.2f).",
-                  GroupName(g), half_ratio, options.max_posterior_to_prior_std);
   } else if (halves > options.max_halves_sigmas) {
     std::snprintf(sentence, sizeof(sentence),
                   "%s kept: the two halves of the frames disagree (%.5g vs "
