@@ -428,6 +428,57 @@ TEST_F(Cli, InlierRefinementBringsTheExportedPointsCloserToTheSurfaces) {
   EXPECT_LT(median[0], 0.8 * median[1]);
 }
 
+// build --grow-planes --debug-growth DIR: an image and the verdict counts
+// per plane; a grown plane's grown cells carry the verdicts they joined on
+// (textured: as many as the build report counts; for a plane without
+// hypothesis cells).
+TEST_F(Cli, DebugGrowthWritesEachPlanesCellVerdicts) {
+  const fs::path data = *root_ / "data";
+  const fs::path map = *root_ / "map_debug_growth";
+  const fs::path dir = *root_ / "growth_cells";
+  const fs::path report = *root_ / "debug_growth_report.json";
+  RunResult r = RunMonomap("build " + data.string() + " -o " + map.string() +
+                           " -q --grow-planes --debug-growth " + dir.string() +
+                           " --report " + report.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::ifstream cells_in(dir / "cells.json");
+  const nlohmann::json cells = nlohmann::json::parse(cells_in);
+  std::ifstream report_in(report);
+  const nlohmann::json growth =
+      nlohmann::json::parse(report_in)["plane_growth"];
+  ASSERT_FALSE(cells["planes"].empty());
+  int grown = 0;
+  for (const auto& p : cells["planes"]) {
+    const cv::Mat image =
+        cv::imread((dir / p["image"].get<std::string>()).string());
+    ASSERT_FALSE(image.empty()) << p["image"];
+    EXPECT_EQ(image.rows, 4 * p["rows"].get<int>());
+    EXPECT_EQ(image.cols, 4 * p["cols"].get<int>());
+    int all = 0;
+    for (const auto& [verdict, n] : p["cells"].items()) all += n.get<int>();
+    EXPECT_EQ(all, p["rows"].get<int>() * p["cols"].get<int>());
+    bool hypothesis = false;  // its count includes the hull's cells
+    for (const auto& h : growth["hypotheses"]) {
+      hypothesis = hypothesis || h["plane_id"] == p["plane_id"];
+    }
+    for (const auto& g : growth["planes"]) {
+      if (g["plane_id"] != p["plane_id"] || hypothesis) continue;
+      EXPECT_EQ(p["grown_cells"]["textured"].get<int>(),
+                g["cells_textured"].get<int>());
+    }
+    grown += p["grown_cells"]["textured"].get<int>() +
+             p["grown_cells"]["plain"].get<int>();
+  }
+  EXPECT_GT(grown, 0);
+  // Without growth there is nothing to show: refused before any work.
+  r = RunMonomap("build " + data.string() + " -o " +
+                 (*root_ / "map_x").string() + " -q --debug-growth " +
+                 (*root_ / "cells_x").string());
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.output.find("--debug-growth"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(*root_ / "map_x"));
+}
+
 // build --grow-planes: the planes grow beyond
 // their points over what the images explain; the report says by how much,
 // more of the world's seen structure is recovered while the grown area

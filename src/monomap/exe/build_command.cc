@@ -7,6 +7,7 @@
 #include <memory>
 
 #include "monomap/exe/commands.h"
+#include "monomap/exe/growth_cell_maps.h"
 #include "monomap/io/dataset.h"
 #include "monomap/pipelines/mapping_pipeline.h"
 #include "monomap/report/html_page.h"
@@ -29,6 +30,7 @@ struct BuildArgs {
   bool no_affine = false;
   bool merge_coplanar = false;  // planes.merge_coplanar + local_ghost_test
   bool grow_planes = false;
+  std::string debug_growth;  // --debug-growth DIR
   bool no_plane_hypotheses = false;
   bool no_direction_snap = false;
   bool quiet = false;
@@ -168,6 +170,10 @@ void AddGrowthOptions(CLI::App* cmd, BuildArgs* a) {
                 "Grow each plane's polygon over the image regions its plane "
                 "explains (photo-consistent across views), beyond its "
                 "points; localization renders only what the points support");
+  cmd->add_option("--debug-growth", a->debug_growth,
+                  "With --grow-planes: write why each cell of each plane "
+                  "did or did not join it (an image per plane and "
+                  "cells.json) to this directory");
   cmd->add_flag("--no-plane-hypotheses", a->no_plane_hypotheses,
                 "With --grow-planes: do not propose planes along the scene's "
                 "directions through the points on no plane (kept only where "
@@ -279,6 +285,11 @@ void RunBuild(const BuildArgs& a) {
     CheckOutputFile(a.report, {a.dataset, a.output}, "--report");
   }
   if (!a.html.empty()) CheckOutputFile(a.html, {a.dataset, a.output}, "--html");
+  if (!a.debug_growth.empty()) {
+    CheckOption(a.grow_planes, "--debug-growth", "needs --grow-planes");
+    CheckOutputDirectory(a.debug_growth, "growth-debug", {a.dataset, a.output},
+                         "--debug-growth");
+  }
   DatasetOptions dataset_options = a.dataset_options;
   if (a.drop_odometry_jumps) {
     dataset_options.odometry_jump_policy = DatasetOptions::JumpPolicy::kDrop;
@@ -299,11 +310,15 @@ void RunBuild(const BuildArgs& a) {
   options.planes.merge_coplanar = a.merge_coplanar;
   options.planes.local_ghost_test = a.merge_coplanar;
   options.growth.enabled = a.grow_planes;
+  options.growth.keep_cell_maps = !a.debug_growth.empty();
   options.hypotheses.enabled = !a.no_plane_hypotheses;
   options.planes.snap_to_directions = !a.no_direction_snap;
   options.show_progress = !a.quiet;
   const MappingResult result = BuildMap(dataset, options);
   WriteMappingResult(a.output, result);
+  if (!a.debug_growth.empty()) {
+    WriteGrowthCellMaps(a.debug_growth, result.report.growth);
+  }
   if (!a.report.empty()) {
     WriteFileAtomic(a.report, result.report.ToJson().dump(2) + "\n");
   }

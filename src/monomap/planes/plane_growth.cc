@@ -135,8 +135,10 @@ class CellJudge {
         projector_(projector) {}
 
   // The cell's evidence; *ncc (if given) receives the median NCC of a
-  // textured cell (-1 otherwise).
-  Evidence Judge(int r, int c, double* ncc = nullptr) const {
+  // textured cell (-1 otherwise), *why (if given) the reason for kNone or
+  // an untextured kInconsistent.
+  Evidence Judge(int r, int c, double* ncc = nullptr,
+                 CellVerdict* why = nullptr) const {
     if (ncc != nullptr) *ncc = -1.0;
     const int n = o_.samples_per_side * o_.samples_per_side;
     std::vector<float> patches;  // n values per seeing view
@@ -160,13 +162,18 @@ class CellJudge {
       gains.push_back(v.exposure_gain);
     }
     const int nv = static_cast<int>(rays.size());
+    CellVerdict unused;
+    if (why == nullptr) why = &unused;
     if (nv < o_.min_views || MaxAngleDeg(rays) < o_.min_parallax_deg) {
+      *why = nv < o_.min_views ? CellVerdict::kFewViews
+                               : CellVerdict::kLowParallax;
       return Evidence::kNone;
     }
-    const Evidence e = Photometric(patches, rays, gains, n, ncc);
+    const Evidence e = Photometric(patches, rays, gains, n, ncc, why);
     if (e == Evidence::kTextured && o_.aperture_test &&
         AlongParallaxOnly(r, c, seeing, rays, patches)) {
       if (ncc != nullptr) *ncc = -1.0;
+      *why = CellVerdict::kAlongParallax;
       return Evidence::kNone;
     }
     return e;
@@ -288,7 +295,7 @@ class CellJudge {
   Evidence Photometric(const std::vector<float>& patches,
                        const std::vector<Eigen::Vector3d>& rays,
                        const std::vector<double>& gains, int n,
-                       double* median_ncc) const {
+                       double* median_ncc, CellVerdict* why) const {
     const int nv = static_cast<int>(rays.size());
     std::vector<double> means(nv), stds(nv);
     for (int v = 0; v < nv; ++v) {
@@ -303,7 +310,10 @@ class CellJudge {
       const double m = Median(means);
       const double band = o_.max_plain_brightness_diff * std::max(m, 10.0);
       for (double mean : means) {
-        if (std::abs(mean - m) > band) return Evidence::kInconsistent;
+        if (std::abs(mean - m) > band) {
+          *why = CellVerdict::kPlainInconsistent;
+          return Evidence::kInconsistent;
+        }
       }
       return Evidence::kPlain;
     }
@@ -505,14 +515,24 @@ class CellEvidence {
     }
   }
 
-  Evidence operator()(int r, int c) const {
-    if (g_.carved(r, c) >= o_.min_carving_landmarks) return Evidence::kNone;
+  // *why (if given): the reason for kNone or an untextured kInconsistent.
+  Evidence operator()(int r, int c, CellVerdict* why = nullptr) const {
+    CellVerdict unused;
+    if (why == nullptr) why = &unused;
+    *why = CellVerdict::kClaimed;
+    if (g_.carved(r, c) >= o_.min_carving_landmarks) {
+      *why = CellVerdict::kCarved;
+      return Evidence::kNone;
+    }
     const int owner = owner_(r, c);
-    if (owner < 0) return judge_.Judge(r, c);
+    if (owner < 0) return judge_.Judge(r, c, nullptr, why);
     if (rival_judges_.empty()) return Evidence::kNone;
     double ncc = -1.0, rival_ncc = -1.0;
-    const Evidence e = judge_.Judge(r, c, &ncc);
-    if (e == Evidence::kPlain) return Evidence::kNone;  // no plane wins
+    const Evidence e = judge_.Judge(r, c, &ncc, why);
+    if (e == Evidence::kPlain) {  // no plane wins
+      *why = CellVerdict::kClaimed;
+      return Evidence::kNone;
+    }
     if (e != Evidence::kTextured) return e;
     rival_judges_[rival_of_[owner]].Judge(r, c, &rival_ncc);
     return ncc >= rival_ncc + o_.hypothesis_min_ncc_gain
@@ -721,6 +741,32 @@ bool ConfirmInside(const PlaneGrowthOptions& o, const CellEvidence& judge,
 // `hypothesis`, the segment is a plane hypothesis: only the cells of its
 // polygon that the images confirm start the growth, and an empty polygon
 // is returned when they do not confirm it.
+// Every cell's verdict (keep_cell_maps), judged again in parallel: the
+// judge is deterministic, so a grown cell gets the verdict it joined on.
+GrowthCellMap MapCells(const Grid& grid, const cv::Mat1b& fitted,
+                       const cv::Mat1b& member, const CellEvidence& judge) {
+  GrowthCellMap map;
+  map.verdict.create(grid.rows, grid.cols);
+  map.fitted = fitted.clone();
+  map.member = member.clone();
+  map.lo = grid.lo;
+  tbb::parallel_for(0, grid.rows, [&](int r) {
+    for (int c = 0; c < grid.cols; ++c) {
+      CellVerdict why = CellVerdict::kFewViews;
+      const Evidence e = judge(r, c, &why);
+      CellVerdict v = why;
+      if (e == Evidence::kTextured) v = CellVerdict::kTextured;
+      if (e == Evidence::kPlain) v = CellVerdict::kPlain;
+      if (e == Evidence::kInconsistent &&
+          why != CellVerdict::kPlainInconsistent) {
+        v = CellVerdict::kInconsistent;
+      }
+      map.verdict(r, c) = static_cast<uint8_t>(v);
+    }
+  });
+  return map;
+}
+
 Polygon2d GrowSegment(const PlaneGrowthOptions& o, const PlaneSegment& seg,
                       const SegmentGrid& g,
                       const std::vector<const PlaneSegment*>& occluders,
@@ -754,6 +800,7 @@ Polygon2d GrowSegment(const PlaneGrowthOptions& o, const PlaneSegment& seg,
   // A hypothesis' plain cells prove nothing either.
   if (hypothesis != nullptr) proof.setTo(0, plain_inside);
   if (o.plain_between_proofs) KeepPlainBetweenProofs(proof, &member, stats);
+  if (o.keep_cell_maps) stats->cell_map = MapCells(grid, inside, member, judge);
   const bool grew =
       stats->cells_textured + stats->cells_plain + stats->cells_hidden > 0;
   if (!grew && hypothesis == nullptr) return seg.polygon;

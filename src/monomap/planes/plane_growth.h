@@ -91,6 +91,9 @@ struct PlaneGrowthOptions {
   // differs between the views. Gains from the tracked features
   // (EstimateExposureGains in plane_growth.cc).
   bool compensate_exposure = true;
+  // Keep every grid cell's verdict per plane (PlaneGrowthStats::cell_map),
+  // for diagnosis (build --debug-growth): judging every cell costs time.
+  bool keep_cell_maps = false;
   // Plain cells may extend at most this many cells from texture evidence.
   int max_plain_run = 8;
   // ... and must lie within the convex hull of the fitted polygon and the
@@ -156,6 +159,30 @@ struct PlaneGrowthOptions {
 };
 
 // One segment's growth.
+// Why growth took or left a cell (PlaneGrowthOptions::keep_cell_maps).
+enum class CellVerdict : uint8_t {
+  kTextured,           // the views correlate through the plane
+  kPlain,              // untextured and equally bright in the views
+  kInconsistent,       // textured, but the views do not correlate
+  kPlainInconsistent,  // untextured, but brighter in some views than others
+  kFewViews,           // fewer than min_views see it (grazing, hidden, outside)
+  kLowParallax,        // its views' rays part by less than min_parallax_deg
+  kAlongParallax,      // aperture test: its texture runs along the parallax
+  kCarved,             // landmark rays pass through it: free space
+  kClaimed,            // another plane's polygon covers it
+};
+constexpr int kNumCellVerdicts = 9;
+
+// Every cell of a plane's growth grid with its verdict (PlaneGrowthOptions::
+// keep_cell_maps; empty otherwise). Row r, column c is the cell whose
+// in-plane corner is lo + cell_m * (c, r).
+struct GrowthCellMap {
+  cv::Mat1b verdict;  // CellVerdict
+  cv::Mat1b fitted;   // 1: inside the fitted polygon (where growth starts)
+  cv::Mat1b member;   // 1: in the grown polygon (before closing gaps)
+  Eigen::Vector2d lo = Eigen::Vector2d::Zero();
+};
+
 struct PlaneGrowthStats {
   int plane_id = 0;
   double cell_m = 0.0;  // cell side (m)
@@ -165,6 +192,7 @@ struct PlaneGrowthStats {
   int cells_plain = 0;     // added as plain bridges
   int cells_carved = 0;    // free space by landmark rays (of the grid)
   int cells_hidden = 0;    // of the fitted polygon, hidden from every view
+  GrowthCellMap cell_map;  // keep_cell_maps only
 };
 
 // One plane hypothesis' check against the images.

@@ -97,6 +97,63 @@ TEST(PlaneGrowth, GrowsOverTheTexturedWallAndStopsAtItsEdges) {
   EXPECT_NEAR(std::abs(PolygonArea(segments[0].landmark_polygon)), 0.12, 1e-9);
 }
 
+// keep_cell_maps: every cell's verdict. A grown cell shows the verdict it
+// joined on (the counts match the report's); over the wall the views
+// correlate through its plane, and through a plane 15 cm off they do not.
+TEST(PlaneGrowth, CellMapsShowWhyEachCellJoinedOrNot) {
+  const TestScene scene = Room();
+  PlaneGrowthOptions o = GrowthOn();
+  o.keep_cell_maps = true;
+  auto grow = [&](double offset_m) {
+    std::vector<PlaneSegment> segments = {FrontWallPatch(scene, offset_m)};
+    return GrowPlanePolygons(o, scene.camera, scene.world_from_cam, {}, {},
+                             Loader(scene), &segments)
+        .planes.at(0);
+  };
+  // Cells of verdict v: the grown ones, or those over the wall's lower
+  // 0.6 m (which the views see).
+  auto count = [](const PlaneGrowthStats& s, CellVerdict v, bool grown_only) {
+    const GrowthCellMap& m = s.cell_map;
+    int n = 0;
+    for (int r = 0; r < m.verdict.rows; ++r) {
+      for (int c = 0; c < m.verdict.cols; ++c) {
+        const Eigen::Vector2d st =
+            m.lo + s.cell_m * Eigen::Vector2d(c + 0.5, r + 0.5);
+        const bool wall =
+            st.x() > 0 && st.x() < 3 && st.y() > 0 && st.y() < 0.6;
+        const bool grown = m.member(r, c) && !m.fitted(r, c);
+        n += m.verdict(r, c) == static_cast<uint8_t>(v) &&
+             (grown_only ? grown : wall);
+      }
+    }
+    return n;
+  };
+  const PlaneGrowthStats on = grow(0.0);
+  const GrowthCellMap& m = on.cell_map;
+  ASSERT_FALSE(m.verdict.empty());
+  EXPECT_EQ(m.fitted.size(), m.verdict.size());
+  EXPECT_EQ(m.member.size(), m.verdict.size());
+  EXPECT_GT(on.cells_textured, 100);
+  EXPECT_EQ(count(on, CellVerdict::kTextured, true), on.cells_textured);
+  const PlaneGrowthStats off = grow(0.15);
+  const int on_textured = count(on, CellVerdict::kTextured, false);
+  const int on_inconsistent = count(on, CellVerdict::kInconsistent, false);
+  const int off_textured = count(off, CellVerdict::kTextured, false);
+  const int off_inconsistent = count(off, CellVerdict::kInconsistent, false);
+  std::printf(
+      "over the wall, textured / inconsistent cells: on it %d / %d, "
+      "15 cm off %d / %d\n",
+      on_textured, on_inconsistent, off_textured, off_inconsistent);
+  EXPECT_GT(on_textured, 3 * on_inconsistent);
+  EXPECT_GT(off_inconsistent, 2 * off_textured);
+  // Off by default.
+  std::vector<PlaneSegment> plain = {FrontWallPatch(scene, 0.0)};
+  EXPECT_TRUE(GrowPlanePolygons(GrowthOn(), scene.camera, scene.world_from_cam,
+                                {}, {}, Loader(scene), &plain)
+                  .planes.at(0)
+                  .cell_map.verdict.empty());
+}
+
 TEST(PlaneGrowth, AWrongPlaneDoesNotGrow) {
   const TestScene scene = Room();
   // 20 cm in front of the wall: the patches shift between views by 5-10 px.
