@@ -736,11 +736,6 @@ bool ConfirmInside(const PlaneGrowthOptions& o, const CellEvidence& judge,
                                   (h->cells_textured + h->cells_inconsistent);
 }
 
-// Grows one segment (its fitted polygon) against the others (occluders).
-// Returns the new polygon, or the fitted one if nothing grew. With
-// `hypothesis`, the segment is a plane hypothesis: only the cells of its
-// polygon that the images confirm start the growth, and an empty polygon
-// is returned when they do not confirm it.
 // Every cell's verdict (keep_cell_maps), judged again in parallel: the
 // judge is deterministic, so a grown cell gets the verdict it joined on.
 GrowthCellMap MapCells(const Grid& grid, const cv::Mat1b& fitted,
@@ -767,6 +762,11 @@ GrowthCellMap MapCells(const Grid& grid, const cv::Mat1b& fitted,
   return map;
 }
 
+// Grows one segment (its fitted polygon) against the others (occluders).
+// Returns the new polygon, or the fitted one if nothing grew. With
+// `hypothesis`, the segment is a plane hypothesis: only the cells of its
+// polygon that the images confirm start the growth, and an empty polygon
+// is returned when they do not confirm it.
 Polygon2d GrowSegment(const PlaneGrowthOptions& o, const PlaneSegment& seg,
                       const SegmentGrid& g,
                       const std::vector<const PlaneSegment*>& occluders,
