@@ -158,7 +158,6 @@ struct PlaneGrowthOptions {
   void Check() const;
 };
 
-// One segment's growth.
 // Why growth took or left a cell (PlaneGrowthOptions::keep_cell_maps).
 enum class CellVerdict : uint8_t {
   kTextured,           // the views correlate through the plane
@@ -183,6 +182,7 @@ struct GrowthCellMap {
   Eigen::Vector2d lo = Eigen::Vector2d::Zero();
 };
 
+// One segment's growth.
 struct PlaneGrowthStats {
   int plane_id = 0;
   double cell_m = 0.0;  // cell side (m)

@@ -59,6 +59,7 @@ struct IntrinsicsRefinementOptions {
   // the model does (lens, odometry, tracker); halves that disagree show it
   // does not, whatever the std says.
   bool check_halves = true;
+  // Largest difference of the halves' values, in combined sigmas.
   double max_halves_sigmas = 3.0;
   // Throws OptionsError naming the field if a value makes no sense.
   void Check() const;
