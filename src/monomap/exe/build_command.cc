@@ -95,8 +95,9 @@ void AddLensOptions(CLI::App* cmd, IntrinsicsRefinementOptions* o) {
   IntrinsicsRefinementOptions& lens = *o;
   cmd->add_flag("--refine-intrinsics", lens.enabled,
                 "Lens self-calibration: bundle adjustment refines the focal "
-                "length and k1, k2 (and with the flag below the principal "
-                "point) under a prior at the given calibration, where the "
+                "length and k1, k2 (and with the flags below the "
+                "principal point and k3) under a prior at the given "
+                "calibration, where the "
                 "data constrain them and both halves of the frames agree "
                 "(the report says which and why)");
   cmd->add_flag("--lens-fix-focal{false}", lens.refine_focal,
@@ -105,6 +106,9 @@ void AddLensOptions(CLI::App* cmd, IntrinsicsRefinementOptions* o) {
                 "With --refine-intrinsics: also try the principal point");
   cmd->add_flag("--lens-fix-radial{false}", lens.refine_radial,
                 "With --refine-intrinsics: keep the given k1, k2");
+  cmd->add_flag("--lens-refine-k3", lens.refine_k3,
+                "With --refine-intrinsics: also try the third radial term k3 "
+                "(trusted only with k1, k2)");
   cmd->add_flag("--lens-no-halves-check{false}", lens.check_halves,
                 "With --refine-intrinsics: trust a group without checking "
                 "that the first and second half of the frames agree on it");
@@ -121,6 +125,9 @@ void AddLensOptions(CLI::App* cmd, IntrinsicsRefinementOptions* o) {
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   cmd->add_option("--lens-k2-sigma", lens.k2_sigma, "Prior sigma of k2")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd->add_option("--lens-k3-sigma", lens.k3_sigma, "Prior sigma of k3")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
 }

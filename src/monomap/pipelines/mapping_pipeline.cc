@@ -321,7 +321,8 @@ namespace {
 
 nlohmann::json LensJson(const std::array<double, kLensSize>& v) {
   return {{"fx", v[kLensFx]}, {"fy", v[kLensFy]}, {"cx", v[kLensCx]},
-          {"cy", v[kLensCy]}, {"k1", v[kLensK1]}, {"k2", v[kLensK2]}};
+          {"cy", v[kLensCy]}, {"k1", v[kLensK1]}, {"k2", v[kLensK2]},
+          {"k3", v[kLensK3]}};
 }
 
 // The trials on each half of the frames (check_halves) and, per group, how
@@ -337,7 +338,8 @@ nlohmann::json HalvesJson(const IntrinsicsRefinementReport& r) {
           {"sigmas_apart",
            {{"focal", r.halves_sigmas[kGroupFocal]},
             {"principal_point", r.halves_sigmas[kGroupPrincipalPoint]},
-            {"radial", r.halves_sigmas[kGroupRadial]}}}};
+            {"radial", r.halves_sigmas[kGroupRadial]},
+            {"k3", r.halves_sigmas[kGroupK3]}}}};
 }
 
 // Lens self-calibration: refined or not and why, before and after, prior
@@ -349,6 +351,7 @@ nlohmann::json IntrinsicsJson(const IntrinsicsRefinementReport& r) {
           {"focal_refined", r.group_refined[kGroupFocal]},
           {"principal_point_refined", r.group_refined[kGroupPrincipalPoint]},
           {"radial_refined", r.group_refined[kGroupRadial]},
+          {"k3_refined", r.group_refined[kGroupK3]},
           {"reason", r.reason},
           {"before", LensJson(LensParameters(r.before))},
           {"after", LensJson(LensParameters(r.after))},

@@ -326,10 +326,8 @@ class BundleAdjuster {
   // Prior and manifold (fixed groups constant) of the lens block.
   void ParameterizeLens();
   internal::LensConstants LensConstantsOf() const {
-    return {camera_.model == LensModel::kEquidistant,
-            {camera_.distortion[2], camera_.distortion[3],
-             camera_.distortion[4]},
-            options_.intrinsics.shared_focal,
+    return {camera_.model == LensModel::kEquidistant, camera_.distortion,
+            ThirdRadialIndex(camera_.model), options_.intrinsics.shared_focal,
             camera_.fy / camera_.fx};
   }
   void AddLandmarkToProblem(size_t i);
@@ -349,9 +347,9 @@ class BundleAdjuster {
   std::vector<PoseParams> poses_;
   std::vector<Eigen::Vector3d> points_;
   std::array<double, 5> distortion_;
-  // Lens block (fx, fy, cx, cy, k1, k2) with self-calibration.
+  // Lens block (fx, fy, cx, cy, k1, k2, k3) with self-calibration.
   std::array<double, kLensSize> lens_;
-  std::array<bool, kNumLensGroups> free_groups_ = {false, false, false};
+  std::array<bool, kNumLensGroups> free_groups_ = {false, false, false, false};
   bool lens_free_ = false;
   std::vector<Rigid3d> cams_from_world_;
   std::vector<char> joint_;  // landmarks in the joint problem
@@ -655,7 +653,7 @@ void BundleAdjuster::UpdateLandmarks(std::vector<Landmark>* landmarks) {
 void BundleAdjuster::SetFreeLensGroups(
     const std::array<bool, kNumLensGroups>& groups) {
   free_groups_ = groups;
-  lens_free_ = groups[0] || groups[1] || groups[2];
+  lens_free_ = groups[0] || groups[1] || groups[2] || groups[3];
 }
 
 // Parameters of the lens block held constant: those of the fixed groups,
@@ -669,6 +667,7 @@ std::vector<int> FixedLensParameters(
     fixed.insert(fixed.end(), {kLensCx, kLensCy});
   }
   if (!free_groups[kGroupRadial]) fixed.insert(fixed.end(), {kLensK1, kLensK2});
+  if (!free_groups[kGroupK3]) fixed.push_back(kLensK3);
   return fixed;
 }
 
@@ -908,7 +907,8 @@ BundleAdjustmentReport BundleAdjust(const Camera& camera,
     // group passes the judgement, else adjusted again without the others.
     lens.attempted = true;
     const std::array<bool, kNumLensGroups> wanted = {
-        io.refine_focal, io.refine_principal_point, io.refine_radial};
+        io.refine_focal, io.refine_principal_point, io.refine_radial,
+        io.refine_k3};
     if (io.check_halves) {
       TrialOnHalves(camera, tracks, options, wanted, *world_from_cam,
                     *landmarks, &lens);

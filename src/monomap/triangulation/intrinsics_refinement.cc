@@ -18,6 +18,7 @@ void IntrinsicsRefinementOptions::Check() const {
               "intrinsics.principal_point_sigma_fraction", "must be positive");
   CheckOption(k1_sigma > 0, "intrinsics.k1_sigma", "must be positive");
   CheckOption(k2_sigma > 0, "intrinsics.k2_sigma", "must be positive");
+  CheckOption(k3_sigma > 0, "intrinsics.k3_sigma", "must be positive");
   CheckOption(max_posterior_to_prior_std > 0 && max_posterior_to_prior_std <= 1,
               "intrinsics.max_posterior_to_prior_std", "must be in (0, 1]");
   CheckOption(
@@ -37,7 +38,8 @@ std::array<double, kLensSize> LensParameters(const Camera& camera) {
           camera.cx,
           camera.cy,
           camera.distortion[0],
-          camera.distortion[1]};
+          camera.distortion[1],
+          camera.distortion[ThirdRadialIndex(camera.model)]};
 }
 
 Camera WithLens(const Camera& camera, const std::array<double, kLensSize>& lens,
@@ -49,6 +51,7 @@ Camera WithLens(const Camera& camera, const std::array<double, kLensSize>& lens,
   c.cy = lens[kLensCy];
   c.distortion[0] = lens[kLensK1];
   c.distortion[1] = lens[kLensK2];
+  c.distortion[ThirdRadialIndex(camera.model)] = lens[kLensK3];
   return c;
 }
 
@@ -60,7 +63,8 @@ std::array<double, kLensSize> LensPriorSigmas(
           pp,
           pp,
           options.k1_sigma,
-          options.k2_sigma};
+          options.k2_sigma,
+          options.k3_sigma};
 }
 
 namespace {
@@ -75,13 +79,15 @@ std::vector<int> GroupParameters(LensGroup group, bool shared_focal) {
       return {kLensCx, kLensCy};
     case kGroupRadial:
       return {kLensK1, kLensK2};
+    case kGroupK3:
+      return {kLensK3};
   }
   return {};
 }
 
 const char* GroupName(int group) {
   static const char* const kNames[] = {"focal length", "principal point",
-                                       "radial distortion"};
+                                       "radial distortion", "k3"};
   return kNames[group];
 }
 
@@ -143,7 +149,7 @@ bool JudgeLensGroup(const IntrinsicsRefinementOptions& options,
   char sentence[240];
   bool trusted = false;
   const bool wanted[] = {options.refine_focal, options.refine_principal_point,
-                         options.refine_radial};
+                         options.refine_radial, options.refine_k3};
   if (!wanted[g]) {
     std::snprintf(sentence, sizeof(sentence), "%s kept: not refined by option.",
                   GroupName(g));
@@ -194,6 +200,11 @@ void JudgeLensGroups(const IntrinsicsRefinementOptions& options,
     std::string why;
     report->group_refined[g] =
         JudgeLensGroup(options, posterior_ok, g, report, &why);
+    if (g == kGroupK3 && report->group_refined[g] &&
+        !report->group_refined[kGroupRadial]) {
+      report->group_refined[g] = false;
+      why = "k3 kept: k1, k2 are, and k3 alone would absorb their error.";
+    }
     report->reason += (g == 0 ? "" : " ") + why;
   }
 }

@@ -36,6 +36,11 @@ struct IntrinsicsRefinementOptions {
   bool refine_focal = true;
   bool refine_principal_point = false;
   bool refine_radial = true;
+  // Also the third radial term (plumb_bob k3, equidistant k3), for a lens
+  // whose rim a two-term model cannot follow. Trusted only with k1, k2:
+  // alone it would absorb their error. Off by default: it loosens k1, k2,
+  // so small scenes keep them (figures: docs/benchmarks.md).
+  bool refine_k3 = false;
   // One focal length for both axes (the given fy/fx ratio is kept).
   bool shared_focal = true;
   // Prior sigma of the focal length, as a fraction of the given fx (fy).
@@ -45,6 +50,8 @@ struct IntrinsicsRefinementOptions {
   // Prior sigmas of the radial coefficients k1 and k2.
   double k1_sigma = 0.05;
   double k2_sigma = 0.05;
+  // Prior sigma of k3.
+  double k3_sigma = 0.05;
   // A group is trusted only if the data shrank its marginal standard
   // deviation to at most this fraction of the prior sigma (0.5: the data
   // carry at least 3 times the prior's information) ...
@@ -66,30 +73,44 @@ struct IntrinsicsRefinementOptions {
 };
 
 // Index of the lens block's parameters.
-enum LensIndex { kLensFx, kLensFy, kLensCx, kLensCy, kLensK1, kLensK2 };
-constexpr int kLensSize = 6;
+enum LensIndex {
+  kLensFx,
+  kLensFy,
+  kLensCx,
+  kLensCy,
+  kLensK1,
+  kLensK2,
+  kLensK3
+};
+constexpr int kLensSize = 7;
 // Groups judged (and refined or kept) together.
-enum LensGroup { kGroupFocal, kGroupPrincipalPoint, kGroupRadial };
-constexpr int kNumLensGroups = 3;
+enum LensGroup { kGroupFocal, kGroupPrincipalPoint, kGroupRadial, kGroupK3 };
+constexpr int kNumLensGroups = 4;
+
+// Index of the third radial term in a camera's distortion array.
+inline int ThirdRadialIndex(LensModel model) {
+  return model == LensModel::kEquidistant ? 2 : 4;
+}
 
 struct IntrinsicsRefinementReport {
   bool attempted = false;  // options.enabled
-  // Groups refined: focal, principal point, radial (k1, k2).
-  std::array<bool, kNumLensGroups> group_refined = {false, false, false};
+  // Groups refined: focal, principal point, radial (k1, k2), k3.
+  std::array<bool, kNumLensGroups> group_refined = {false, false, false, false};
   bool refined() const {
-    return group_refined[0] || group_refined[1] || group_refined[2];
+    return group_refined[0] || group_refined[1] || group_refined[2] ||
+           group_refined[3];
   }
   // Why each group was refined or kept, one sentence per group.
   std::string reason;
   Camera before;  // the given calibration
   Camera after;   // the one the poses and points go with
   // Prior and marginal (posterior) standard deviations of fx, fy, cx, cy,
-  // k1, k2 from the trial adjustment; 0 if held fixed, posterior -1 if the
+  // k1, k2, k3 from the trial adjustment; 0 if held fixed, posterior -1 if the
   // covariance could not be computed.
-  std::array<double, kLensSize> prior_std = {0, 0, 0, 0, 0, 0};
-  std::array<double, kLensSize> posterior_std = {0, 0, 0, 0, 0, 0};
+  std::array<double, kLensSize> prior_std{};
+  std::array<double, kLensSize> posterior_std{};
   // Values after the trial adjustment.
-  std::array<double, kLensSize> candidate = {0, 0, 0, 0, 0, 0};
+  std::array<double, kLensSize> candidate{};
   // The trials on the first and the second half of the frames (check_halves;
   // halves_checked false otherwise): their values and marginal standard
   // deviations (-1 if not computed), and per group the largest difference
@@ -97,12 +118,12 @@ struct IntrinsicsRefinementReport {
   bool halves_checked = false;
   std::array<std::array<double, kLensSize>, 2> halves_candidate{};
   std::array<std::array<double, kLensSize>, 2> halves_std{};
-  std::array<double, kNumLensGroups> halves_sigmas = {-1, -1, -1};
+  std::array<double, kNumLensGroups> halves_sigmas = {-1, -1, -1, -1};
   double covariance_seconds = 0.0;
 };
 
 // The lens block of a camera, and the camera with a lens block applied
-// (distortion[2..4] unchanged).
+// (the other distortion coefficients unchanged).
 std::array<double, kLensSize> LensParameters(const Camera& camera);
 Camera WithLens(const Camera& camera, const std::array<double, kLensSize>& lens,
                 bool shared_focal);
@@ -122,19 +143,23 @@ void JudgeLensGroups(const IntrinsicsRefinementOptions& options,
 namespace internal {
 
 // Camera-frame point -> raw pixel with the lens block (fx, fy, cx, cy, k1,
-// k2) as parameters and the camera's distortion[2..4] fixed; with a shared
-// focal, fy = fx * fy_over_fx. Caller checks z > 0.
+// k2, k3) as parameters and the camera's other distortion coefficients
+// fixed; with a shared focal, fy = fx * fy_over_fx. Caller checks z > 0.
 struct LensConstants {
   bool equidistant = false;            // lens model (else plumb_bob)
-  std::array<double, 3> fixed_tail{};  // distortion[2..4]
+  std::array<double, 5> distortion{};  // the camera's (k1, k2, k3 replaced)
+  int k3_index = 4;                    // ThirdRadialIndex of the model
   bool shared_focal = true;
   double fy_over_fx = 1.0;
 };
 template <typename T>
 inline void ProjectWithLens(const LensConstants& c, const T* lens,
                             const T* x_in_cam, T* px) {
-  const T distortion[5] = {lens[kLensK1], lens[kLensK2], T(c.fixed_tail[0]),
-                           T(c.fixed_tail[1]), T(c.fixed_tail[2])};
+  T distortion[5];
+  for (int k = 0; k < 5; ++k) distortion[k] = T(c.distortion[k]);
+  distortion[0] = lens[kLensK1];
+  distortion[1] = lens[kLensK2];
+  distortion[c.k3_index] = lens[kLensK3];
   T xd, yd;
   DistortNormalized(c.equidistant, distortion, T(x_in_cam[0] / x_in_cam[2]),
                     T(x_in_cam[1] / x_in_cam[2]), &xd, &yd);
