@@ -213,6 +213,25 @@ Errors AdjustWithLens(const testing::TestScene& scene, const Camera& camera,
   return Compare(scene, poses, landmarks);
 }
 
+// The scene adjusted with its true lens (no self-calibration), and with
+// `given` under options `a` and under options `b`.
+struct LensTrials {
+  Errors with_true, with_a, with_b;
+  BundleAdjustmentReport report_a, report_b;
+};
+LensTrials AdjustThreeWays(const testing::TestScene& scene, const Camera& given,
+                           const std::vector<Rigid3d>& odometry,
+                           const BundleAdjustmentOptions& a,
+                           const BundleAdjustmentOptions& b) {
+  LensTrials t;
+  t.with_true = AdjustWithLens(scene, scene.camera, scene.tracks, odometry, {});
+  t.with_a =
+      AdjustWithLens(scene, given, scene.tracks, odometry, a, &t.report_a);
+  t.with_b =
+      AdjustWithLens(scene, given, scene.tracks, odometry, b, &t.report_b);
+  return t;
+}
+
 // A calibration whose k1 is off by 0.02 (~1.5 px at 300 px from the centre)
 // bends the adjusted poses; refining the distortion in the adjustment finds
 // the lens again and straightens them.
@@ -473,13 +492,10 @@ TEST(BundleAdjustmentTest, SelfCalibrationRecoversAPerturbedRadialLens) {
       scene.world_from_cam, testing::OdometryDriftOptions());
   BundleAdjustmentOptions refine;
   refine.intrinsics.enabled = true;
-  BundleAdjustmentReport true_report, wrong_report, refined_report;
-  const Errors with_true = AdjustWithLens(scene, scene.camera, scene.tracks,
-                                          odometry, {}, &true_report);
-  const Errors with_wrong =
-      AdjustWithLens(scene, wrong, scene.tracks, odometry, {}, &wrong_report);
-  const Errors refined = AdjustWithLens(scene, wrong, scene.tracks, odometry,
-                                        refine, &refined_report);
+  const LensTrials t = AdjustThreeWays(scene, wrong, odometry, {}, refine);
+  const Errors &with_true = t.with_true, &with_wrong = t.with_a,
+               &refined = t.with_b;
+  const BundleAdjustmentReport& refined_report = t.report_b;
   const IntrinsicsRefinementReport& lens = refined_report.intrinsics;
   std::printf(
       "k1 true %.4f, given %.4f, refined %.4f (std %.5f); points: true lens "
@@ -533,14 +549,12 @@ TEST(BundleAdjustmentTest, SelfCalibrationFindsAThirdRadialTerm) {
   BundleAdjustmentOptions two_terms, three_terms;
   two_terms.intrinsics.enabled = three_terms.intrinsics.enabled = true;
   three_terms.intrinsics.refine_k3 = true;
-  BundleAdjustmentReport true_report, two_report, three_report;
-  const Errors with_true =
-      AdjustWithLens(scene, rim, scene.tracks, odometry, {}, &true_report);
-  const Errors with_two = AdjustWithLens(scene, given, scene.tracks, odometry,
-                                         two_terms, &two_report);
-  const Errors with_three = AdjustWithLens(scene, given, scene.tracks, odometry,
-                                           three_terms, &three_report);
-  const IntrinsicsRefinementReport& lens = three_report.intrinsics;
+  const LensTrials t =
+      AdjustThreeWays(scene, given, odometry, two_terms, three_terms);
+  const Errors &with_true = t.with_true, &with_two = t.with_a,
+               &with_three = t.with_b;
+  const BundleAdjustmentReport& two_report = t.report_a;
+  const IntrinsicsRefinementReport& lens = t.report_b.intrinsics;
   std::printf(
       "k3 true %.4f, refined %.4f (std %.5f, halves %.1f sigmas); points: "
       "true lens %.3f mm, two terms %.3f mm, three %.3f mm; rotation %.4f / "
