@@ -95,10 +95,9 @@ void AddLensOptions(CLI::App* cmd, IntrinsicsRefinementOptions* o) {
   IntrinsicsRefinementOptions& lens = *o;
   cmd->add_flag("--refine-intrinsics", lens.enabled,
                 "Lens self-calibration: bundle adjustment refines the focal "
-                "length and k1, k2 (and with the flags below the "
-                "principal point and k3) under a prior at the given "
-                "calibration, where the "
-                "data constrain them and both halves of the frames agree "
+                "length and k1, k2 (and with the flags below the principal "
+                "point and k3) under a prior at the given calibration, where "
+                "the data constrain them and both halves of the frames agree "
                 "(the report says which and why)");
   cmd->add_flag("--lens-fix-focal{false}", lens.refine_focal,
                 "With --refine-intrinsics: keep the given focal length");

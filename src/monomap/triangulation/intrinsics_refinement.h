@@ -26,7 +26,7 @@
 namespace monomap {
 
 struct IntrinsicsRefinementOptions {
-  // Refine focal length, principal point and k1, k2 with the poses and
+  // Refine focal length, principal point and k1, k2 (k3) with the poses and
   // points (when the data constrain them). Off by default: figures in
   // docs/benchmarks.md.
   bool enabled = false;
