@@ -322,7 +322,7 @@ class BundleAdjuster {
   const std::array<double, kLensSize>& lens() const { return lens_; }
 
  private:
-  bool LensFree() const { return lens_free_; }
+  bool LensFree() const { return AnyLensGroup(free_groups_); }
   // Prior and manifold (fixed groups constant) of the lens block.
   void ParameterizeLens();
   internal::LensConstants LensConstantsOf() const {
@@ -349,8 +349,7 @@ class BundleAdjuster {
   std::array<double, 5> distortion_;
   // Lens block (fx, fy, cx, cy, k1, k2, k3) with self-calibration.
   std::array<double, kLensSize> lens_;
-  std::array<bool, kNumLensGroups> free_groups_ = {false, false, false, false};
-  bool lens_free_ = false;
+  std::array<bool, kNumLensGroups> free_groups_{};
   std::vector<Rigid3d> cams_from_world_;
   std::vector<char> joint_;  // landmarks in the joint problem
   // Frames adjusted (first_ .. last_); frames outside follow by odometry.
@@ -653,7 +652,6 @@ void BundleAdjuster::UpdateLandmarks(std::vector<Landmark>* landmarks) {
 void BundleAdjuster::SetFreeLensGroups(
     const std::array<bool, kNumLensGroups>& groups) {
   free_groups_ = groups;
-  lens_free_ = groups[0] || groups[1] || groups[2] || groups[3];
 }
 
 // Parameters of the lens block held constant: those of the fixed groups,

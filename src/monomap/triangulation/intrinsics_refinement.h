@@ -17,6 +17,7 @@
 // equidistant).
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <string>
 
@@ -87,6 +88,11 @@ constexpr int kLensSize = 7;
 enum LensGroup { kGroupFocal, kGroupPrincipalPoint, kGroupRadial, kGroupK3 };
 constexpr int kNumLensGroups = 4;
 
+// Whether any group is set.
+inline bool AnyLensGroup(const std::array<bool, kNumLensGroups>& groups) {
+  return std::find(groups.begin(), groups.end(), true) != groups.end();
+}
+
 // Index of the third radial term in a camera's distortion array.
 inline int ThirdRadialIndex(LensModel model) {
   return model == LensModel::kEquidistant ? 2 : 4;
@@ -95,11 +101,8 @@ inline int ThirdRadialIndex(LensModel model) {
 struct IntrinsicsRefinementReport {
   bool attempted = false;  // options.enabled
   // Groups refined: focal, principal point, radial (k1, k2), k3.
-  std::array<bool, kNumLensGroups> group_refined = {false, false, false, false};
-  bool refined() const {
-    return group_refined[0] || group_refined[1] || group_refined[2] ||
-           group_refined[3];
-  }
+  std::array<bool, kNumLensGroups> group_refined{};
+  bool refined() const { return AnyLensGroup(group_refined); }
   // Why each group was refined or kept, one sentence per group.
   std::string reason;
   Camera before;  // the given calibration
