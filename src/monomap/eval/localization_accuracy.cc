@@ -2,6 +2,9 @@
 
 #include <cmath>
 #include <limits>
+#include <tuple>
+#include <utility>
+#include <vector>
 
 #include "monomap/eval/trajectory_metrics.h"
 #include "monomap/util/angles.h"
@@ -14,6 +17,26 @@ namespace {
 // NaN (and infinities) as JSON null.
 nlohmann::json Number(double v) {
   return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json();
+}
+
+// Mean errors of the matched pairs from `first` on after one rigid offset
+// (se3-poses); NaN for fewer than 3 pairs.
+std::pair<double, double> RigidMeanErrors(
+    const std::vector<TimedPose>& estimate,
+    const std::vector<TimedPose>& groundtruth,
+    const std::vector<std::pair<size_t, size_t>>& pairs, size_t first) {
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  if (pairs.size() < first + 3) return {kNaN, kNaN};
+  std::vector<TimedPose> est, gt;
+  for (size_t k = first; k < pairs.size(); ++k) {
+    est.push_back(estimate[pairs[k].first]);
+    gt.push_back(groundtruth[pairs[k].second]);
+    // Paired by index: one timestamp for both.
+    est.back().timestamp = gt.back().timestamp = static_cast<double>(k);
+  }
+  const TrajectoryErrors e =
+      AbsoluteTrajectoryError(est, gt, Alignment::kSE3Poses);
+  return {e.translation_m.mean, e.rotation_deg.mean};
 }
 
 }  // namespace
@@ -37,6 +60,8 @@ nlohmann::json LocalizationAccuracy::ToJson(bool per_step) const {
   j["final_rotation_error_deg"] = Number(final_rotation_error_deg);
   j["mean_translation_error_m"] = Number(mean_translation_error_m);
   j["mean_rotation_error_deg"] = Number(mean_rotation_error_deg);
+  j["mean_translation_error_rigid_m"] = Number(mean_translation_error_rigid_m);
+  j["mean_rotation_error_rigid_deg"] = Number(mean_rotation_error_rigid_deg);
   j["mean_translation_error_all_m"] = Number(mean_translation_error_all_m);
   j["mean_rotation_error_all_deg"] = Number(mean_rotation_error_all_deg);
   if (per_step) {
@@ -105,6 +130,8 @@ LocalizationAccuracy EvaluateLocalization(
     a.mean_translation_error_m = std::numeric_limits<double>::quiet_NaN();
     a.mean_rotation_error_deg = std::numeric_limits<double>::quiet_NaN();
   }
+  std::tie(a.mean_translation_error_rigid_m, a.mean_rotation_error_rigid_deg) =
+      RigidMeanErrors(estimate, groundtruth, pairs, first);
   return a;
 }
 

@@ -62,6 +62,29 @@ TEST(LocalizationAccuracyTest, ConvergesAtAKnownStep) {
   EXPECT_FALSE(a.ToJson(false).contains("translation_error_m"));
 }
 
+TEST(LocalizationAccuracyTest, RemovesOneRigidOffsetOfTheMapFrame) {
+  const auto gt = GroundTruth(90);
+  // Lost for 20 steps, then exact in a frame turned by 0.3 deg (about a
+  // tilted axis) and shifted by 2 cm: a map frame off the truth's.
+  const Rigid3d est_from_gt(
+      Eigen::Quaterniond(Eigen::AngleAxisd(
+          DegToRad(0.3), Eigen::Vector3d(0.2, 1.0, 0.4).normalized())),
+      Eigen::Vector3d(0.02, 0.0, 0.0));
+  std::vector<TimedPose> est = gt;
+  for (int i = 0; i < 90; ++i) {
+    est[i].world_from_cam = est_from_gt * gt[i].world_from_cam;
+    if (i < 20) est[i].world_from_cam.translation.y() += 3.0;
+  }
+  const LocalizationAccuracy a = EvaluateLocalization(est, gt);
+  EXPECT_EQ(a.converged_step, 20);
+  EXPECT_NEAR(a.mean_rotation_error_deg, 0.3, 1e-6);
+  EXPECT_GT(a.mean_translation_error_m, 0.015);
+  EXPECT_LT(a.mean_rotation_error_rigid_deg, 1e-6);
+  EXPECT_LT(a.mean_translation_error_rigid_m, 1e-9);
+  EXPECT_NEAR(a.ToJson(false)["mean_rotation_error_rigid_deg"].get<double>(),
+              a.mean_rotation_error_rigid_deg, 1e-12);
+}
+
 TEST(LocalizationAccuracyTest, BothThresholdsMustHold) {
   const auto gt = GroundTruth(50);
   // Position right from step 10 but heading 8 deg off until step 20.
@@ -90,6 +113,7 @@ TEST(LocalizationAccuracyTest, NeverConverges) {
   EXPECT_NEAR(a.final_translation_error_m, 1.5, 1e-9);
   EXPECT_TRUE(std::isnan(a.mean_translation_error_m));
   EXPECT_TRUE(std::isnan(a.mean_rotation_error_deg));
+  EXPECT_TRUE(std::isnan(a.mean_rotation_error_rigid_deg));
   EXPECT_NEAR(a.mean_translation_error_all_m, 1.5, 1e-9);
   const nlohmann::json j = a.ToJson(false);
   EXPECT_TRUE(j["mean_translation_error_m"].is_null());

@@ -31,6 +31,7 @@ Alignment ParseAlignment(const std::string& name) {
   if (name == "se3") return Alignment::kSE3;
   if (name == "sim3") return Alignment::kSim3;
   if (name == "sim3-poses") return Alignment::kSim3Poses;
+  if (name == "se3-poses") return Alignment::kSE3Poses;
   throw OptionsError(
       "alignment: expected none, first, se3, sim3 or sim3-poses, got '" + name +
       "'");
@@ -69,12 +70,13 @@ std::vector<std::pair<size_t, size_t>> AssociateByTimestamp(
 
 namespace {
 
-// kSim3Poses: rotation = the chordal mean of R_gt R_est^T (projected onto
-// SO(3)); with it fixed, scale and translation minimise
-// sum |s R p_est + t - p_gt|^2 in closed form.
+// kSim3Poses / kSE3Poses: rotation = the chordal mean of R_gt R_est^T
+// (projected onto SO(3)); with it fixed, scale (1 without `with_scale`) and
+// translation minimise sum |s R p_est + t - p_gt|^2 in closed form.
 Sim3d AlignPoses(const std::vector<TimedPose>& est,
                  const std::vector<TimedPose>& gt,
-                 const std::vector<std::pair<size_t, size_t>>& pairs) {
+                 const std::vector<std::pair<size_t, size_t>>& pairs,
+                 bool with_scale) {
   Eigen::Matrix3d sum = Eigen::Matrix3d::Zero();
   Eigen::Vector3d mean_est = Eigen::Vector3d::Zero();
   Eigen::Vector3d mean_gt = Eigen::Vector3d::Zero();
@@ -99,13 +101,13 @@ Sim3d AlignPoses(const std::vector<TimedPose>& est,
     num += p.dot(gt[j].world_from_cam.translation - mean_gt);
     den += p.squaredNorm();
   }
-  if (!(den > 0.0) || !(num > 0.0)) {
+  if (with_scale && (!(den > 0.0) || !(num > 0.0))) {
     throw StageError(
         "trajectory evaluation: estimated positions do not move, the scale "
         "of a sim3-poses alignment is undetermined");
   }
   Sim3d sim;
-  sim.scale = num / den;
+  sim.scale = with_scale ? num / den : 1.0;
   sim.rigid =
       Rigid3d(Eigen::Quaterniond(r), mean_gt - sim.scale * r * mean_est);
   return sim;
@@ -117,7 +119,7 @@ Sim3d AlignMatched(const std::vector<TimedPose>& est,
                    Alignment alignment) {
   const size_t needed =
       (alignment == Alignment::kSE3 || alignment == Alignment::kSim3 ||
-       alignment == Alignment::kSim3Poses)
+       alignment == Alignment::kSim3Poses || alignment == Alignment::kSE3Poses)
           ? 3
           : 2;
   if (pairs.size() < needed) {
@@ -134,7 +136,8 @@ Sim3d AlignMatched(const std::vector<TimedPose>& est,
                   est[pairs[0].first].world_from_cam.Inverse();
       return sim;
     case Alignment::kSim3Poses:
-      return AlignPoses(est, gt, pairs);
+    case Alignment::kSE3Poses:
+      return AlignPoses(est, gt, pairs, alignment == Alignment::kSim3Poses);
     case Alignment::kSE3:
     case Alignment::kSim3:
       break;

@@ -26,10 +26,13 @@ enum class Alignment {
                // least squares on the positions: determined also for a
                // straight drive, where kSim3 leaves the roll about the
                // line free
+  kSE3Poses,   // the same without scale: removes one rigid offset of the
+               // estimate's frame (a monocular map's frame is its
+               // odometry's) and leaves its scale error in
 };
 
-// "none", "first", "se3", "sim3" or "sim3-poses" -> Alignment. Throws OptionsError for
-// another name.
+// "none", "first", "se3", "sim3", "sim3-poses" or "se3-poses" -> Alignment.
+// Throws OptionsError for another name.
 Alignment ParseAlignment(const std::string& name);
 
 struct TrajectoryErrors {

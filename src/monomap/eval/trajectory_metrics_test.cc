@@ -149,6 +149,47 @@ TEST(AbsoluteTrajectoryErrorTest, Sim3PosesRecoversScaleAlsoOnALine) {
   EXPECT_EQ(ParseAlignment("sim3-poses"), Alignment::kSim3Poses);
 }
 
+TEST(AbsoluteTrajectoryErrorTest, Se3PosesRemovesOneRigidOffsetOnly) {
+  // A straight drive in a frame turned by 0.05 deg about the line (which
+  // positions alone leave free) and shifted, 1 % long, 0.02 deg of noise.
+  const Rigid3d gt_from_est(Eigen::Quaterniond(Eigen::AngleAxisd(
+                                DegToRad(0.05), Eigen::Vector3d::UnitX())),
+                            Eigen::Vector3d(0.01, -0.02, 0.003));
+  std::mt19937 rng(4);
+  std::normal_distribution<double> noise(0.0, DegToRad(0.02));
+  std::vector<TimedPose> gt(40), est(40);
+  for (int i = 0; i < 40; ++i) {
+    gt[i].timestamp = est[i].timestamp = i;
+    gt[i].world_from_cam.translation = Eigen::Vector3d(0.05 * i, 0, 0.4);
+    est[i].world_from_cam = gt_from_est.Inverse() * gt[i].world_from_cam;
+    est[i].world_from_cam.rotation =
+        est[i].world_from_cam.rotation *
+        Eigen::Quaterniond(Eigen::AngleAxisd(
+            noise(rng), Eigen::Vector3d(0.3, 0.5, 0.8).normalized()));
+    est[i].world_from_cam.translation *= 1.01;
+  }
+  const Sim3d align = AlignTrajectories(est, gt, Alignment::kSE3Poses);
+  EXPECT_EQ(align.scale, 1.0);
+  // The offset's rotation comes back to within the noise's mean (0.02 deg
+  // / sqrt(40)) ...
+  EXPECT_LT(RadToDeg(AngleBetween(align.rigid.rotation, gt_from_est.rotation)),
+            0.01);
+  // ... the orientations' own noise is left, not the offset ...
+  const TrajectoryErrors rigid =
+      AbsoluteTrajectoryError(est, gt, Alignment::kSE3Poses);
+  const TrajectoryErrors none =
+      AbsoluteTrajectoryError(est, gt, Alignment::kNone);
+  EXPECT_GT(none.rotation_deg.mean, 0.045);
+  EXPECT_LT(rigid.rotation_deg.mean, 0.035);
+  // ... and the 1 % scale error stays (1 % of up to 1 m from the middle),
+  // which sim3-poses removes down to the rotation's residual error.
+  EXPECT_GT(rigid.translation_m.max, 0.008);
+  EXPECT_LT(
+      AbsoluteTrajectoryError(est, gt, Alignment::kSim3Poses).translation_m.max,
+      5e-4);
+  EXPECT_EQ(ParseAlignment("se3-poses"), Alignment::kSE3Poses);
+}
+
 TEST(AbsoluteTrajectoryErrorTest, FirstPoseExactForGlobalTransform) {
   const auto gt = GroundTruth();
   const auto est = Transformed(gt, 1.0, 0.0, 0.0, 9);

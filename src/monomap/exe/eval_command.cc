@@ -25,9 +25,9 @@ void AddAlignmentOptions(CLI::App* cmd, AlignmentArgs* a) {
                   "(sim3 removes the scale error the odometry gives the "
                   "map); sim3-poses: the similarity with its rotation from "
                   "the trajectory's orientations (determined also for a "
-                  "straight drive)")
-      ->check(
-          CLI::IsMember({"none", "first-pose", "se3", "sim3", "sim3-poses"}))
+                  "straight drive); se3-poses: the same without scale")
+      ->check(CLI::IsMember(
+          {"none", "first-pose", "se3", "sim3", "sim3-poses", "se3-poses"}))
       ->capture_default_str();
   cmd->add_option("--groundtruth", a->groundtruth,
                   "Ground-truth trajectory (TUM) for --align");

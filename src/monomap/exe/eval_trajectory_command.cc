@@ -24,8 +24,10 @@ void RegisterEvalTrajectoryCommand(CLI::App* eval) {
       ->required();
   cmd->add_option("--align", a->align,
                   "none | first | se3 | sim3 | sim3-poses (the similarity "
-                  "with its rotation from the orientations)")
-      ->check(CLI::IsMember({"none", "first", "se3", "sim3", "sim3-poses"}))
+                  "with its rotation from the orientations) | se3-poses "
+                  "(the same without scale: one rigid offset removed)")
+      ->check(CLI::IsMember(
+          {"none", "first", "se3", "sim3", "sim3-poses", "se3-poses"}))
       ->capture_default_str();
   cmd->add_option("--delta", a->delta, "Frame delta of the relative error")
       ->capture_default_str();

@@ -102,7 +102,7 @@ DemoLocalization RunDemoLocalization(const Map& map,
     lo.state = LocalizationState::kPlanar;
     lo.init.kind = LocalizationInit::kGlobal;
     lo.mcl.SetParticleBudget(options.particles);
-    lo.seed = mapping_sim.seed;
+    lo.seed = mapping_sim.seed + options.filter_seed_offset;
     DemoLocalizationRun run;
     run.name = method == LocalizationMethod::kMcc ? "MCC" : "MCL";
     std::vector<std::vector<Particle>> sets;

@@ -35,6 +35,9 @@ struct DemoLocalizationOptions {
   // Its run seed is the world seed plus this (other odometry errors and
   // image noise than the mapping run).
   uint64_t run_seed_offset = 1000;
+  // The filters' seed is the world seed plus this: other values show the
+  // filter's own scatter on one map and traversal.
+  uint64_t filter_seed_offset = 0;
   // Particle budget of both methods (initial count and KLD maximum). A
   // corridor seen at 80x60 has look-alike stretches metres apart; 1000
   // particles over the whole hallway often lock onto one of them, 3000
