@@ -969,6 +969,13 @@ TEST(CliHelp, BuildShowsTheMappingOptionsDefaults) {
             Shown(o.bundle_adjustment.translation_sigma_fraction));
   EXPECT_EQ(HelpDefault(r.output, "--odometry-span-rotation-sigma-deg"),
             Shown(o.bundle_adjustment.span_rotation_sigma_deg));
+  EXPECT_EQ(HelpDefault(r.output, "--ba-loss"), o.bundle_adjustment.loss);
+  EXPECT_EQ(HelpDefault(r.output, "--ba-loss-scale"),
+            Shown(o.bundle_adjustment.loss_scale_px));
+  // A loss the adjustment does not know is a usage error (exit 2).
+  const RunResult bad = RunMonomap("build . -o out --ba-loss tukey");
+  EXPECT_EQ(bad.exit_code, 2) << bad.output;
+  EXPECT_NE(bad.output.find("--ba-loss"), std::string::npos) << bad.output;
 }
 
 TEST(CliHelp, LocalizeShowsTheLocalizerOptionsDefaults) {

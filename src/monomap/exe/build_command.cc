@@ -84,6 +84,17 @@ void AddBundleAdjustmentOptions(CLI::App* cmd, BundleAdjustmentOptions* o) {
                   "Rotation sigma of the span priors (degrees)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
+  cmd->add_option("--ba-loss", o->loss,
+                  "Robust loss of bundle adjustment's reprojection residuals: "
+                  "huber | cauchy (weighs the tail of mistracked "
+                  "observations down harder) | none")
+      ->check(CLI::IsMember({"huber", "cauchy", "none"}))
+      ->capture_default_str();
+  cmd->add_option("--ba-loss-scale", o->loss_scale_px,
+                  "Scale of that loss (px): residuals beyond it are "
+                  "weighted down")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   cmd->add_flag("--refine-distortion", o->refine_distortion,
                 "Bundle adjustment refines the lens distortion coefficients");
   cmd->add_flag("--ba-verbose", o->verbose,
