@@ -153,7 +153,8 @@ int main(int argc, char** argv) {
   app.add_option("--world-seeds", o.world_seeds, "Hallway seeds")
       ->delimiter(',');
   app.add_option("--filter-seeds", o.filter_seeds,
-                 "Filter seed offsets per world seed");
+                 "Filter seed offsets per world seed")
+      ->check(CLI::PositiveNumber);
   app.add_option("--frames", o.frames, "Frames of the mapping run");
   app.add_option("--localization-frames", o.localization_frames,
                  "Frames of the localized traversal");

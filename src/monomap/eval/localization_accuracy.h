@@ -50,8 +50,8 @@ struct LocalizationAccuracy {
   double mean_rotation_error_deg = 0.0;
   // The same after removing one rigid offset of the estimate's frame (the
   // steps from converged_step aligned by se3-poses): a monocular map's
-  // frame is its odometry's, and bundle adjustment may turn it by some
-  // hundredths of a degree. NaN if it never converged or < 3 steps did.
+  // frame is its odometry's, and bundle adjustment may turn it slightly.
+  // NaN if it never converged or < 3 steps did.
   double mean_translation_error_rigid_m = 0.0;
   double mean_rotation_error_rigid_deg = 0.0;
   // Mean errors over all evaluated steps.

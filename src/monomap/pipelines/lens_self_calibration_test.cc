@@ -27,8 +27,8 @@ struct LensRun {
   double mcc_mean_rotation_deg = 0.0;
   double mcc_fraction_within = 0.0;
   // The same after removing one rigid offset of the map's frame
-  // (LocalizationAccuracy): the true lens' map frame is itself 0.01-0.07
-  // deg off on seeds 1-3, so the absolute rotation compares frames too.
+  // (LocalizationAccuracy): even the true lens' map frame is turned off the
+  // truth's, so the absolute rotation compares frames too.
   double mcc_rigid_translation_m = 0.0;
   double mcc_rigid_rotation_deg = 0.0;
   DemoReport report;
@@ -117,7 +117,7 @@ TEST(LensSelfCalibrationTest, PerturbedLensMapsAndLocalizesAsTheTrueLens) {
             1.1 * truth.mcc_mean_translation_m + 0.002);
   // Rotation: the wrong lens costs a factor ~15; the refined one comes
   // back within the 10 % of the true lens, absolute and with the
-  // map frame's offset removed (where it is +3 %).
+  // map frame's offset removed.
   EXPECT_LT(refined.mcc_mean_rotation_deg, 1.1 * truth.mcc_mean_rotation_deg);
   EXPECT_LT(refined.mcc_mean_rotation_deg, 0.25 * wrong.mcc_mean_rotation_deg);
   EXPECT_LT(refined.mcc_rigid_rotation_deg, 1.1 * truth.mcc_rigid_rotation_deg);
