@@ -28,7 +28,7 @@ struct BuildArgs {
   // Negative flags, applied to `options` after parsing.
   bool no_bundle_adjustment = false;
   bool no_affine = false;
-  bool merge_coplanar = false;  // planes.merge_coplanar + local_ghost_test
+  bool no_merge_coplanar = false;
   bool grow_planes = false;
   std::string debug_growth;  // --debug-growth DIR
   bool no_plane_hypotheses = false;
@@ -260,9 +260,13 @@ void AddMappingOptions(CLI::App* cmd, BuildArgs* a) {
   cmd->add_option("--ransac-iterations", o.planes.ransac_iterations,
                   "RANSAC hypotheses per plane")
       ->capture_default_str();
-  cmd->add_flag("--merge-coplanar", a->merge_coplanar,
-                "Merge plane segments that are one physical plane, and keep "
-                "surfaces beside a plane (a recessed door) apart");
+  cmd->add_flag("--no-merge-coplanar", a->no_merge_coplanar,
+                "Keep the plane segments that lie on one physical plane "
+                "apart; by default they are merged");
+  cmd->add_flag("--local-ghost-test", o.planes.local_ghost_test,
+                "Reject a plane as another's noisy ghost only by its points "
+                "over that plane's polygon, so a surface beside a plane (a "
+                "recessed door) is kept");
   cmd->add_flag("--no-direction-snap", a->no_direction_snap,
                 "Keep every plane's least-squares normal; by default a plane "
                 "whose points allow it takes the direction of the scene's "
@@ -324,8 +328,7 @@ void RunBuild(const BuildArgs& a) {
   MappingOptions options = a.options;
   options.bundle_adjustment.enabled = !a.no_bundle_adjustment;
   options.tracking.affine_refinement = !a.no_affine;
-  options.planes.merge_coplanar = a.merge_coplanar;
-  options.planes.local_ghost_test = a.merge_coplanar;
+  options.planes.merge_coplanar = !a.no_merge_coplanar;
   options.growth.enabled = a.grow_planes;
   options.growth.keep_cell_maps = !a.debug_growth.empty();
   options.hypotheses.enabled = !a.no_plane_hypotheses;

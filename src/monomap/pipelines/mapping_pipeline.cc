@@ -399,13 +399,14 @@ nlohmann::json PlanesJson(const PlaneFittingReport& planes) {
                       {"outliers", planes.num_outliers},
                       {"absorbed_outliers", planes.absorbed},
                       {"inliers_per_plane", planes.inliers_per_plane}};
-  // Segments merged into one plane (ids as fitted), empty unless merging is on.
+  // Segments merged into one plane (ids as fitted); empty when merging is off.
   j["merges"] = nlohmann::json::array();
   for (const auto& m : planes.merges) {
     j["merges"].push_back({{"kept_id", m.kept_id},
                            {"merged_id", m.merged_id},
                            {"angle_deg", m.angle_deg},
-                           {"offset_m", m.offset_m}});
+                           {"offset_m", m.offset_m},
+                           {"offset_thresholds", m.offset_thresholds}});
   }
   // Segments whose normal was snapped to a direction of the scene (ids as
   // fitted).

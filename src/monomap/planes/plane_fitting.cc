@@ -65,6 +65,9 @@ void PlaneFittingOptions::Check() const {
               "planes.merge_max_offset_m", "must be finite and >= 0");
   CheckOption(merge_max_gap_m >= 0 && std::isfinite(merge_max_gap_m),
               "planes.merge_max_gap_m", "must be finite and >= 0");
+  CheckOption(merge_max_offset_thresholds >= 0 &&
+                  std::isfinite(merge_max_offset_thresholds),
+              "planes.merge_max_offset_thresholds", "must be finite and >= 0");
 }
 
 double CovarianceBand(const Landmark& l, const Eigen::Vector3d& n, double k) {
@@ -572,14 +575,18 @@ std::vector<int> InlierLandmarks(
   return out;
 }
 
+double Median(std::vector<double> v) {
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
 double MedianDistance(const Plane& plane,
                       const std::vector<Eigen::Vector3d>& x) {
   std::vector<double> d(x.size());
   for (size_t i = 0; i < x.size(); ++i) {
     d[i] = std::abs(plane.SignedDistance(x[i]));
   }
-  std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
-  return d[d.size() / 2];
+  return Median(std::move(d));
 }
 
 // Smallest distance between the polygons of a and b, in a's plane.
@@ -603,20 +610,47 @@ struct MergeItem {
   int fitted_id = 0;
 };
 
+// Median inlier threshold of a segment's points.
+double MedianThreshold(const FitState& s, const MergeItem& item) {
+  std::vector<double> t(item.lms.size());
+  for (size_t k = 0; k < t.size(); ++k) t[k] = s.thresholds[item.lms[k]];
+  return Median(std::move(t));
+}
+
+// Median over a segment's points of their distance to `plane` in units of
+// their own inlier threshold.
+double MedianRelativeDistance(const FitState& s, const Plane& plane,
+                              const MergeItem& item) {
+  std::vector<double> d(item.pts.size());
+  for (size_t k = 0; k < d.size(); ++k) {
+    d[k] =
+        std::abs(plane.SignedDistance(item.pts[k])) / s.thresholds[item.lms[k]];
+  }
+  return Median(std::move(d));
+}
+
 // Whether a and b are one physical plane: normals and offsets agree within
-// the noise (centroids and each one's inliers against the other's fit) and
-// their supports touch. Fills the merge record's angle and offset, and *gap.
-bool SameSurface(const PlaneFittingOptions& o, const PlaneSegment& a,
-                 const MergeItem& ia, const PlaneSegment& b,
-                 const MergeItem& ib, PlaneFittingReport::Merge* m,
-                 double* gap) {
+// the noise (centroids and each one's inliers against the other's fit, in
+// metres and in the points' own thresholds) and their supports touch.
+// Fills the merge record's angle and offsets, and *gap.
+bool SameSurface(const FitState& s, const PlaneSegment& a, const MergeItem& ia,
+                 const PlaneSegment& b, const MergeItem& ib,
+                 PlaneFittingReport::Merge* m, double* gap) {
+  const PlaneFittingOptions& o = s.options;
   m->angle_deg = RadToDeg(PlaneAngle(a.plane, b.plane));
   if (m->angle_deg > o.merge_max_angle_deg) return false;
-  m->offset_m =
-      std::max({std::abs(b.plane.SignedDistance(a.frame.origin)),
-                std::abs(a.plane.SignedDistance(b.frame.origin)),
-                MedianDistance(b.plane, ia.pts), MedianDistance(a.plane, ib.pts)});
-  if (m->offset_m > o.merge_max_offset_m) return false;
+  const double a_off = std::abs(b.plane.SignedDistance(a.frame.origin));
+  const double b_off = std::abs(a.plane.SignedDistance(b.frame.origin));
+  m->offset_m = std::max({a_off, b_off, MedianDistance(b.plane, ia.pts),
+                          MedianDistance(a.plane, ib.pts)});
+  m->offset_thresholds =
+      std::max({a_off / MedianThreshold(s, ia), b_off / MedianThreshold(s, ib),
+                MedianRelativeDistance(s, b.plane, ia),
+                MedianRelativeDistance(s, a.plane, ib)});
+  if (m->offset_m > o.merge_max_offset_m ||
+      m->offset_thresholds > o.merge_max_offset_thresholds) {
+    return false;
+  }
   *gap = PolygonGap(a, b);
   return *gap <= o.merge_max_gap_m;
 }
@@ -661,7 +695,7 @@ bool MergeOnePair(FitState* s, std::vector<MergeItem>* items) {
       MergeItem& a = (*items)[i];
       const MergeItem& b = (*items)[j];
       double gap = 0.0;
-      if (!SameSurface(s->options, segs[i], a, segs[j], b, &m, &gap)) {
+      if (!SameSurface(*s, segs[i], a, segs[j], b, &m, &gap)) {
         continue;
       }
       m.kept_id = a.fitted_id;

@@ -89,8 +89,8 @@ struct PlaneFittingOptions {
   double polygon_cell_factor = 0.5;
   // Count only a candidate's points over an accepted segment's polygon in
   // the ghost test, so that a surface beside a segment (a door leaf
-  // recessed in its wall) is a plane of its own. Opt-in with merge_coplanar,
-  // whose merging it needs: alone it splits walls; together they were not
+  // recessed in its wall) is a plane of its own. Opt-in; needs
+  // merge_coplanar: alone it splits walls, and with merging it was not
   // better over the whole benchmark set (docs/design-notes.md).
   bool local_ghost_test = false;
   // Give a segment the direction of the scene's well-determined planes, or
@@ -107,15 +107,19 @@ struct PlaneFittingOptions {
   // A segment's normal becomes a direction for the later segments when its
   // standard error (NormalStandardErrorRad) is at most this (deg).
   double direction_max_error_deg = 0.5;
-  // Merge segments of one physical plane (issue 18); opt-in, see
-  // local_ghost_test.
-  bool merge_coplanar = false;
+  // Merge segments of one physical plane: RANSAC's connectivity split cuts a
+  // wall into pieces where its texture has gaps.
+  bool merge_coplanar = true;
   // Largest angle between the normals of two segments that are merged (deg).
   double merge_max_angle_deg = 2.0;
   // Largest offset between them: each centroid, and the median of each one's
-  // inliers, to the other's plane (m). Below a door's 5 cm recess and a
-  // keyboard's height above its desk.
-  double merge_max_offset_m = 0.015;
+  // inliers, to the other's plane (m). Below a door's 5 cm recess.
+  double merge_max_offset_m = 0.03;
+  // The same offsets in units of the points' own inlier thresholds
+  // (LandmarkInlierThreshold; the centroids' in their segment's median
+  // threshold) must also stay within this: pieces of a far wall differ by
+  // more than a near desk and the keyboard on it.
+  double merge_max_offset_thresholds = 1.0;
   // Largest gap between their polygons in the plane (m): supports that touch.
   double merge_max_gap_m = 0.3;
 
@@ -142,6 +146,9 @@ struct PlaneFittingReport {
     int merged_id = 0;
     double angle_deg = 0.0;  // between their normals
     double offset_m = 0.0;   // largest of the offsets tested
+    // Largest of the offsets in inlier thresholds
+    // (merge_max_offset_thresholds).
+    double offset_thresholds = 0.0;
   };
   std::vector<Merge> merges;
   // One segment whose normal was snapped to a direction of the scene (id as
