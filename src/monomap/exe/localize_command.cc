@@ -5,6 +5,7 @@
 // The options bind to the fields of a default-constructed LocalizerOptions,
 // so `--help` shows the library's defaults.
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <memory>
 
@@ -169,6 +170,11 @@ void PrintSummary(const LocalizationReport& r, const std::string& output) {
     std::fprintf(stderr, ", rmse %.4f m, final %.4f m / %.3f deg",
                  r.rmse_translation_m, r.final_translation_error_m,
                  r.final_rotation_error_deg);
+    if (std::isfinite(r.mean_rotation_error_rigid_deg)) {
+      std::fprintf(stderr, ", one rigid offset removed %.4f m / %.3f deg",
+                   r.mean_translation_error_rigid_m,
+                   r.mean_rotation_error_rigid_deg);
+    }
   }
   std::fprintf(stderr, " -> %s\n", output.c_str());
 }

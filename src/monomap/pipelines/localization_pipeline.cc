@@ -28,6 +28,12 @@ nlohmann::json LocalizationReport::ToJson() const {
     j["final_translation_error_m"] = final_translation_error_m;
     j["final_rotation_error_deg"] = final_rotation_error_deg;
     j["fraction_within_10cm"] = fraction_within_10cm;
+    for (const auto& [key, v] : {std::pair{"mean_translation_error_rigid_m",
+                                           mean_translation_error_rigid_m},
+                                 std::pair{"mean_rotation_error_rigid_deg",
+                                           mean_rotation_error_rigid_deg}}) {
+      j[key] = std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
+    }
   }
   nlohmann::json steps_json = nlohmann::json::array();
   for (const LocalizerStepStats& s : steps) {
@@ -104,6 +110,8 @@ void AddErrors(const Dataset& dataset, const std::vector<TimedPose>& estimate,
   report->final_translation_error_m = a.final_translation_error_m;
   report->final_rotation_error_deg = a.final_rotation_error_deg;
   report->fraction_within_10cm = static_cast<double>(within) / a.matched;
+  report->mean_translation_error_rigid_m = a.mean_translation_error_rigid_m;
+  report->mean_rotation_error_rigid_deg = a.mean_rotation_error_rigid_deg;
 }
 
 }  // namespace

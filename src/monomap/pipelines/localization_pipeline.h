@@ -49,6 +49,11 @@ struct LocalizationReport {
   double final_rotation_error_deg = 0.0;
   // Share of frames with translation error below within_m.
   double fraction_within_10cm = 0.0;
+  // Mean errors after converging, once one rigid offset between the
+  // estimate's and the truth's frame is removed (a map's frame is its
+  // odometry's; LocalizationAccuracy); NaN (JSON null) if too few steps.
+  double mean_translation_error_rigid_m = 0.0;
+  double mean_rotation_error_rigid_deg = 0.0;
   std::vector<LocalizerStepStats> steps;
 
   // The figures above (errors only with has_errors) and per step:

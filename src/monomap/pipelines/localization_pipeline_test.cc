@@ -122,6 +122,10 @@ TEST_F(LocalizationPipelineTest, TracksFromAGivenPoseAndReportsErrors) {
   EXPECT_LT(r.rmse_translation_m, 0.01);
   EXPECT_LT(r.mean_rotation_error_deg, 0.5);
   EXPECT_DOUBLE_EQ(r.fraction_within_10cm, 1.0);
+  // Removing one rigid offset leaves no more than the absolute error.
+  ASSERT_TRUE(std::isfinite(r.mean_rotation_error_rigid_deg));
+  EXPECT_LE(r.mean_rotation_error_rigid_deg, r.mean_rotation_error_deg);
+  EXPECT_LT(r.mean_translation_error_rigid_m, r.rmse_translation_m);
   // The final error is the last estimate's distance to the truth.
   EXPECT_DOUBLE_EQ(
       r.final_translation_error_m,
@@ -131,6 +135,8 @@ TEST_F(LocalizationPipelineTest, TracksFromAGivenPoseAndReportsErrors) {
   const nlohmann::json j = r.ToJson();
   EXPECT_EQ(j["frames"].get<int>(), 10);
   EXPECT_DOUBLE_EQ(j["rmse_translation_m"].get<double>(), r.rmse_translation_m);
+  EXPECT_DOUBLE_EQ(j["mean_rotation_error_rigid_deg"].get<double>(),
+                   r.mean_rotation_error_rigid_deg);
   ASSERT_EQ(j["steps"].size(), 10u);
   EXPECT_EQ(j["steps"][9]["particles"].get<int>(), r.steps[9].particles);
   EXPECT_EQ(j["steps"][9].size(), 14u);
@@ -141,6 +147,7 @@ TEST_F(LocalizationPipelineTest, TracksFromAGivenPoseAndReportsErrors) {
   const LocalizationReport r2 = LocalizeSequence(map_, no_truth, o, nullptr);
   EXPECT_FALSE(r2.has_errors);
   EXPECT_FALSE(r2.ToJson().contains("rmse_translation_m"));
+  EXPECT_FALSE(r2.ToJson().contains("mean_rotation_error_rigid_deg"));
 }
 
 TEST_F(LocalizationPipelineTest, PlanarStateNeedsTheMountAnd2dOdometry) {
