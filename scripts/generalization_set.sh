@@ -41,6 +41,8 @@ SIM_CASES=(
   "office_s3_h0.3_p20_f15 office 3 0.3 20 15 0.3"
   "office_s4_h1.5_p0_f30  office 4 1.5 0 30 0.6"
   "room_s1_h0.8_p5_f10    room 1 0.8 5 10 0.3"
+  "room_s2_h1.2_p15_f20   room 2 1.2 15 20 0.4"
+  "room_s3_h0.4_p0_f15    room 3 0.4 0 15 0.3"
   "labcorner_s3_h0.5_p10_f10 lab-corner 3 0.5 10 10 0.3"
 )
 
