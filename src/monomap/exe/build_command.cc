@@ -29,6 +29,7 @@ struct BuildArgs {
   bool no_bundle_adjustment = false;
   bool no_affine = false;
   bool no_merge_coplanar = false;
+  bool no_see_through = false;
   bool grow_planes = false;
   std::string debug_growth;  // --debug-growth DIR
   bool no_plane_hypotheses = false;
@@ -263,6 +264,9 @@ void AddMappingOptions(CLI::App* cmd, BuildArgs* a) {
   cmd->add_flag("--no-merge-coplanar", a->no_merge_coplanar,
                 "Keep the plane segments that lie on one physical plane "
                 "apart; by default they are merged");
+  cmd->add_flag("--no-see-through-check", a->no_see_through,
+                "Keep the planes through which the cameras saw more of the "
+                "map than lies on them; by default they are dropped");
   cmd->add_flag("--local-ghost-test", o.planes.local_ghost_test,
                 "Reject a plane as another's noisy ghost only by its points "
                 "over that plane's polygon, so a surface beside a plane (a "
@@ -329,6 +333,7 @@ void RunBuild(const BuildArgs& a) {
   options.bundle_adjustment.enabled = !a.no_bundle_adjustment;
   options.tracking.affine_refinement = !a.no_affine;
   options.planes.merge_coplanar = !a.no_merge_coplanar;
+  options.see_through.enabled = !a.no_see_through;
   options.growth.enabled = a.grow_planes;
   options.growth.keep_cell_maps = !a.debug_growth.empty();
   options.hypotheses.enabled = !a.no_plane_hypotheses;

@@ -19,6 +19,7 @@ void MappingOptions::Check() const {
   triangulation.Check();
   bundle_adjustment.Check();
   planes.Check();
+  see_through.Check();
   growth.Check();
   hypotheses.Check();
   homographies.Check();
@@ -197,15 +198,16 @@ void AssignInliers(size_t first, const std::vector<PlaneSegment>& segments,
   }
 }
 
-// The fitting report counts the confirmed hypotheses' segments (from `first`
-// on) too, so that it describes the map's planes and outliers.
-void CountHypothesisPlanes(size_t first,
-                           const std::vector<PlaneSegment>& segments,
-                           const std::vector<Landmark>& landmarks,
-                           PlaneFittingReport* planes) {
-  for (size_t i = first; i < segments.size(); ++i) {
+// The fitting report describes the map's planes and outliers: the segments
+// left after fitting and the see-through check, then also the confirmed
+// hypotheses' (from `first` on).
+void CountPlanes(size_t first, const std::vector<PlaneSegment>& segments,
+                 const std::vector<Landmark>& landmarks,
+                 PlaneFittingReport* planes) {
+  planes->inliers_per_plane.clear();
+  for (const PlaneSegment& seg : segments) {
     planes->inliers_per_plane.push_back(
-        static_cast<int>(segments[i].inlier_ids.size()));
+        static_cast<int>(seg.inlier_ids.size()));
   }
   planes->from_hypotheses = static_cast<int>(segments.size() - first);
   planes->num_planes = static_cast<int>(segments.size());
@@ -226,6 +228,11 @@ void SurfaceStages(const Dataset& dataset, const MappingOptions& options,
   for (const auto& p : world_from_cam) centers.push_back(p.translation);
   report.planes =
       FitPlanes(options.planes, &landmarks, &result->segments, &centers);
+  report.see_through = DropSeeThroughSegments(
+      options.see_through, options.planes, world_from_cam, tracks, &landmarks,
+      &result->segments);
+  CountPlanes(result->segments.size(), result->segments, landmarks,
+              &report.planes);
   report.timings.push_back({"planes", timer.ElapsedSeconds()});
   timer.Restart();
   auto load_grey = [&](int frame) { return dataset.LoadImage(frame, false); };
@@ -239,7 +246,7 @@ void SurfaceStages(const Dataset& dataset, const MappingOptions& options,
                                     landmarks, tracks, load_grey,
                                     &result->segments, hypotheses);
   AssignInliers(fitted, result->segments, &landmarks);
-  CountHypothesisPlanes(fitted, result->segments, landmarks, &report.planes);
+  CountPlanes(fitted, result->segments, landmarks, &report.planes);
   report.timings.push_back({"plane_growth", timer.ElapsedSeconds()});
   auto load_image = [&](int frame) { return dataset.LoadImage(frame, true); };
   timer.Restart();
@@ -421,6 +428,19 @@ nlohmann::json PlanesJson(const PlaneFittingReport& planes) {
   return j;
 }
 
+// Per fitted segment, the landmarks seen through it; the segments dropped
+// for it (ids as fitted).
+nlohmann::json SeeThroughJson(const SeeThroughReport& r) {
+  nlohmann::json j = {{"seen_through", r.seen_through},
+                      {"dropped", nlohmann::json::array()}};
+  for (const auto& d : r.dropped) {
+    j["dropped"].push_back({{"segment_id", d.segment_id},
+                            {"inliers", d.inliers},
+                            {"seen_through", d.seen_through}});
+  }
+  return j;
+}
+
 // Per plane: area before and after growth, and the cells added by texture
 // evidence and as plain bridges.
 nlohmann::json GrowthJson(const PlaneGrowthReport& growth) {
@@ -517,6 +537,7 @@ nlohmann::json MappingReport::ToJson() const {
        retriangulation.mean_reprojection_error_px}};
   j["bundle_adjustment"] = BundleAdjustmentJson(bundle_adjustment);
   j["planes"] = PlanesJson(planes);
+  j["see_through"] = SeeThroughJson(see_through);
   j["plane_growth"] = GrowthJson(growth);
   j["homographies"] = {
       {"count", homographies.num_homographies},

@@ -14,6 +14,7 @@
 #include "monomap/planes/plane_fitting.h"
 #include "monomap/planes/plane_growth.h"
 #include "monomap/planes/plane_hypotheses.h"
+#include "monomap/planes/see_through.h"
 #include "monomap/texture/image_plane_homography.h"
 #include "monomap/texture/mosaic.h"
 #include "monomap/tracking/klt_tracker.h"
@@ -33,6 +34,8 @@ struct MappingOptions {
   BundleAdjustmentOptions bundle_adjustment;
   // Stage 3: RANSAC planes.
   PlaneFittingOptions planes;
+  // Stage 3a: segments the cameras saw through are dropped.
+  SeeThroughOptions see_through;
   // Stage 3b: plane polygons grown over the image regions their plane
   // explains.
   PlaneGrowthOptions growth;
@@ -86,6 +89,7 @@ struct MappingReport {
   // Triangulation against the adjusted poses (strict thresholds).
   TriangulationReport retriangulation;
   PlaneFittingReport planes;
+  SeeThroughReport see_through;
   PlaneGrowthReport growth;
   HomographyReport homographies;
   MosaicReport mosaic;
