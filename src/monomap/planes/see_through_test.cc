@@ -67,6 +67,22 @@ class SeeThroughTest : public ::testing::Test {
     segments_.push_back(seg);
   }
 
+  // The patch (segment 0, listed first so that dropping it renumbers the
+  // wall) and the wall (segment 1); `hidden`: no wall point behind the
+  // patch was seen. Returns the check's report.
+  SeeThroughReport PatchAndWall(uint64_t seed, bool hidden,
+                                const SeeThroughOptions& options) {
+    std::mt19937_64 rng(seed);
+    patch_ = Add(0.5, 1.0, 0.3, 0.7, 0.06, 40, false, &rng);
+    wall_ = Add(0.0, 2.0, 0.0, 1.0, 0.0, 600, hidden, &rng);
+    AddSegment(patch_, 0.06);
+    AddSegment(wall_, 0.0);
+    return DropSeeThroughSegments(options, PlaneFittingOptions(),
+                                  world_from_cam_, tracks_, &landmarks_,
+                                  &segments_);
+  }
+
+  std::vector<int> patch_, wall_;
   std::vector<Rigid3d> world_from_cam_;
   std::vector<Landmark> landmarks_;
   std::vector<Track> tracks_;
@@ -76,15 +92,8 @@ class SeeThroughTest : public ::testing::Test {
 TEST_F(SeeThroughTest, ALayerInFrontOfTheWallItsPointsShowIsDropped) {
   // Drifted features as a layer 6 cm in front of a wall whose own points
   // behind the layer were tracked and triangulated: the cameras saw through
-  // the layer, so it is no surface. Listed first, so the wall is renumbered.
-  std::mt19937_64 rng(1);
-  const auto layer = Add(0.5, 1.0, 0.3, 0.7, 0.06, 40, false, &rng);
-  const auto wall = Add(0.0, 2.0, 0.0, 1.0, 0.0, 600, false, &rng);
-  AddSegment(layer, 0.06);
-  AddSegment(wall, 0.0);
-  const SeeThroughReport r =
-      DropSeeThroughSegments(SeeThroughOptions(), PlaneFittingOptions(),
-                             world_from_cam_, tracks_, &landmarks_, &segments_);
+  // the layer, so it is no surface.
+  const SeeThroughReport r = PatchAndWall(1, false, SeeThroughOptions());
   ASSERT_EQ(r.seen_through.size(), 2u);
   // About 600 x 0.2 / 2 = 60 wall points lie behind the layer.
   EXPECT_GT(r.seen_through[0], 40);
@@ -96,40 +105,26 @@ TEST_F(SeeThroughTest, ALayerInFrontOfTheWallItsPointsShowIsDropped) {
   ASSERT_EQ(segments_.size(), 1u);
   EXPECT_EQ(segments_[0].id, 0);
   EXPECT_EQ(segments_[0].inlier_ids.size(), 600u);
-  for (int i : layer) EXPECT_EQ(landmarks_[i].plane_id, -1);
-  for (int i : wall) EXPECT_EQ(landmarks_[i].plane_id, 0);
+  for (int i : patch_) EXPECT_EQ(landmarks_[i].plane_id, -1);
+  for (int i : wall_) EXPECT_EQ(landmarks_[i].plane_id, 0);
 }
 
 TEST_F(SeeThroughTest, ARealSurfaceThatHidesTheWallIsKept) {
   // The same patch as a real surface (a box face): nothing behind it was
-  // seen, so both planes stay. Disabled, the check changes nothing either.
-  std::mt19937_64 rng(2);
-  const auto patch = Add(0.5, 1.0, 0.3, 0.7, 0.06, 40, false, &rng);
-  const auto wall = Add(0.0, 2.0, 0.0, 1.0, 0.0, 600, true, &rng);
-  AddSegment(patch, 0.06);
-  AddSegment(wall, 0.0);
-  const SeeThroughReport r =
-      DropSeeThroughSegments(SeeThroughOptions(), PlaneFittingOptions(),
-                             world_from_cam_, tracks_, &landmarks_, &segments_);
+  // seen, so both planes stay.
+  const SeeThroughReport r = PatchAndWall(2, true, SeeThroughOptions());
   EXPECT_TRUE(r.dropped.empty());
   // A few wall points just past the patch's edge, which these cameras (all
   // seeing every point) see through its rim at an angle.
   EXPECT_LT(r.seen_through[0], 10);
   EXPECT_EQ(segments_.size(), 2u);
-  EXPECT_EQ(landmarks_[patch[0]].plane_id, 0);
+  EXPECT_EQ(landmarks_[patch_[0]].plane_id, 0);
 }
 
 TEST_F(SeeThroughTest, DisabledKeepsEverySegmentAndBadOptionsThrow) {
-  std::mt19937_64 rng(3);
-  const auto layer = Add(0.5, 1.0, 0.3, 0.7, 0.06, 40, false, &rng);
-  const auto wall = Add(0.0, 2.0, 0.0, 1.0, 0.0, 600, false, &rng);
-  AddSegment(layer, 0.06);
-  AddSegment(wall, 0.0);
   SeeThroughOptions off;
   off.enabled = false;
-  const SeeThroughReport r =
-      DropSeeThroughSegments(off, PlaneFittingOptions(), world_from_cam_,
-                             tracks_, &landmarks_, &segments_);
+  const SeeThroughReport r = PatchAndWall(3, false, off);
   EXPECT_TRUE(r.dropped.empty());
   EXPECT_EQ(segments_.size(), 2u);
   SeeThroughOptions bad;
