@@ -63,8 +63,8 @@ struct PlaneFittingOptions {
   // A new plane within this angle (deg) of an accepted segment whose inliers
   // lie on average within ghost_distance_factor x their threshold of that
   // segment's plane is a "ghost" (the segment's noisier points) and is
-  // rejected; its points become outliers. The leftover points of a wall
-  // seen at grazing angles fit planes tilted by more than 3 deg.
+  // rejected; its points become outliers. Wide enough for the tilted fits
+  // that a wall seen at grazing angles leaves (docs/design-notes.md).
   double ghost_max_angle_deg = 5.0;
   // See ghost_max_angle_deg.
   double ghost_distance_factor = 3.0;
