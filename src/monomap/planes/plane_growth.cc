@@ -14,11 +14,13 @@
 #include "monomap/camera/distorted_projector.h"
 #include "monomap/geometry/polygon.h"
 #include "monomap/planes/cell_outline.h"
+#include "monomap/planes/plane_fitting.h"
+#include "monomap/planes/ray_crossing.h"
 #include "monomap/util/angles.h"
 #include "monomap/util/error.h"
 #include "monomap/util/image_sampling.h"
-#include "monomap/util/stats.h"
 #include "monomap/util/progress.h"
+#include "monomap/util/stats.h"
 
 namespace monomap {
 
@@ -376,29 +378,25 @@ cv::Mat1i CarvingCounts(const PlaneGrowthOptions& o, const PlaneSegment& seg,
     const Landmark& l = landmarks[li];
     const auto it = tracks.find(l.id);
     if (it == tracks.end() || !l.x_in_world.allFinite()) continue;
-    const double var = n.dot(l.covariance_m2_per_px2 * n);
-    const double band = std::max(o.carve_margin_factor * grid.cell,
-                                 std::isfinite(var) && var > 0 ? 3 * std::sqrt(var) : 0.0);
+    const double band =
+        std::max(o.carve_margin_factor * grid.cell, CovarianceBand(l, n, 3.0));
     const double s_l = seg.plane.SignedDistance(l.x_in_world);
     if (std::abs(s_l) <= band) continue;
-    const auto& obs = it->second->observations;
-    const int m = static_cast<int>(obs.size());
-    const int rays = std::min(m, o.max_carving_rays);
-    for (int k = 0; k < rays; ++k) {
-      const int f = obs[rays > 1 ? k * (m - 1) / (rays - 1) : 0].frame;
-      if (f < 0 || f >= static_cast<int>(world_from_cam.size())) continue;
-      const Eigen::Vector3d& c = world_from_cam[f].translation;
-      const double s_c = seg.plane.SignedDistance(c);
-      if (s_c * s_l >= 0) continue;  // on the camera's side: not behind
-      const Eigen::Vector3d hit = c + s_c / (s_c - s_l) * (l.x_in_world - c);
-      const Eigen::Vector2d q = (seg.frame.ToPlane(hit) - grid.lo) / grid.cell;
-      const int col = static_cast<int>(std::floor(q.x()));
-      const int row = static_cast<int>(std::floor(q.y()));
-      if (row < 0 || col < 0 || row >= grid.rows || col >= grid.cols) continue;
-      if (last(row, col) == li) continue;  // count landmarks, not rays
-      last(row, col) = li;
-      ++counts(row, col);
-    }
+    ForEachCrossingRay(
+        seg.plane, l.x_in_world, s_l, *it->second, world_from_cam,
+        o.max_carving_rays, [&](const Eigen::Vector3d& hit) {
+          const Eigen::Vector2d q =
+              (seg.frame.ToPlane(hit) - grid.lo) / grid.cell;
+          const int col = static_cast<int>(std::floor(q.x()));
+          const int row = static_cast<int>(std::floor(q.y()));
+          if (row < 0 || col < 0 || row >= grid.rows || col >= grid.cols) {
+            return false;
+          }
+          if (last(row, col) == li) return false;  // count landmarks, not rays
+          last(row, col) = li;
+          ++counts(row, col);
+          return false;
+        });
   }
   return counts;
 }

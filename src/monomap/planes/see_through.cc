@@ -7,6 +7,7 @@
 #include <unordered_map>
 
 #include "monomap/geometry/polygon.h"
+#include "monomap/planes/ray_crossing.h"
 #include "monomap/util/error.h"
 
 namespace monomap {
@@ -19,20 +20,6 @@ void SeeThroughOptions::Check() const {
               "must be >= 0");
   CheckOption(max_rays >= 1, "see_through.max_rays", "must be >= 1");
 }
-
-namespace {
-
-// Whether the ray from camera centre c to x crosses the segment's plane
-// inside its polygon (c and x on opposite sides).
-bool CrossesPolygon(const PlaneSegment& seg, const Eigen::Vector3d& c,
-                    const Eigen::Vector3d& x, double s_x) {
-  const double s_c = seg.plane.SignedDistance(c);
-  if (s_c * s_x >= 0) return false;
-  const Eigen::Vector3d hit = c + s_c / (s_c - s_x) * (x - c);
-  return PointInPolygon(seg.polygon, seg.frame.ToPlane(hit));
-}
-
-}  // namespace
 
 int CountSeenThrough(const SeeThroughOptions& options,
                      const PlaneFittingOptions& fitting,
@@ -51,18 +38,14 @@ int CountSeenThrough(const SeeThroughOptions& options,
     const double band =
         std::max(LandmarkInlierThreshold(fitting, l), CovarianceBand(l, n, k));
     if (std::abs(s_x) <= band) continue;
-    const std::vector<Observation>& obs = track->observations;
-    const int m = static_cast<int>(obs.size());
-    const int rays = std::min(m, options.max_rays);
-    for (int r = 0; r < rays; ++r) {
-      const int f = obs[rays > 1 ? r * (m - 1) / (rays - 1) : 0].frame;
-      if (f < 0 || f >= static_cast<int>(world_from_cam.size())) continue;
-      if (CrossesPolygon(segment, world_from_cam[f].translation, l.x_in_world,
-                         s_x)) {
-        ++count;
-        break;
-      }
-    }
+    bool seen = false;
+    ForEachCrossingRay(segment.plane, l.x_in_world, s_x, *track, world_from_cam,
+                       options.max_rays, [&](const Eigen::Vector3d& hit) {
+                         seen = PointInPolygon(segment.polygon,
+                                               segment.frame.ToPlane(hit));
+                         return seen;
+                       });
+    count += seen;
   }
   return count;
 }
