@@ -524,7 +524,8 @@ TEST_F(Cli, GrowPlanesRecoversMoreOfTheSeenStructure) {
       EXPECT_GE(p["area_after_m2"].get<double>(),
                 p["area_before_m2"].get<double>());
     }
-    // A grown plane keeps its points' extent, inside the grown one.
+    // A plane reaching past its inliers (over absorbed loose points, or
+    // grown) keeps their extent, inside the larger one.
     int with_landmark_polygon = 0;
     for (const TexturedPlane& p : ReadMap(map).planes) {
       if (p.landmark_polygon.empty()) continue;
@@ -534,8 +535,6 @@ TEST_F(Cli, GrowPlanesRecoversMoreOfTheSeenStructure) {
     }
     if (grow) {
       EXPECT_GE(with_landmark_polygon, 1);
-    } else {
-      EXPECT_EQ(with_landmark_polygon, 0);
     }
     const fs::path json = *root_ / ("grow_eval" + std::to_string(grow) + ".json");
     r = RunMonomap("eval structure " + map.string() + " --structure " +
@@ -548,7 +547,7 @@ TEST_F(Cli, GrowPlanesRecoversMoreOfTheSeenStructure) {
   }
   std::printf("area recovered %.3f -> %.3f, on the truth %.3f -> %.3f\n",
               recall[0], recall[1], precision[0], precision[1]);
-  // Measured (40 frames, 320x240): 0.140 -> 0.164, all of it on the truth.
+  // Measured (40 frames, 320x240): 0.162 -> 0.192, all of it on the truth.
   EXPECT_GT(recall[1], recall[0] + 0.015);
   EXPECT_GT(precision[1], 0.95);
 }

@@ -264,6 +264,10 @@ void AddMappingOptions(CLI::App* cmd, BuildArgs* a) {
   cmd->add_flag("--no-merge-coplanar", a->no_merge_coplanar,
                 "Keep the plane segments that lie on one physical plane "
                 "apart; by default they are merged");
+  cmd->add_flag("!--no-extend-planes", o.planes.extend_to_absorbed,
+                "Bound each plane by its inliers only; by default its polygon "
+                "also covers the loose points next to it that lie on it "
+                "within their uncertainty");
   cmd->add_flag("--no-see-through-check", a->no_see_through,
                 "Keep the planes through which the cameras saw more of the "
                 "map than lies on them; by default they are dropped");

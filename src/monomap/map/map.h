@@ -64,8 +64,10 @@ struct PlaneSegment {
   std::vector<Eigen::Vector2d> inlier_st;
   // Bounded extent in (s, t) plane coordinates (metres).
   Polygon2d polygon;
-  // The extent its landmarks support (the fitted polygon), when plane
-  // growth changed `polygon`; empty otherwise (then it is `polygon`).
+  // The extent its inliers support (their outline), when `polygon` reaches
+  // further: over the points plane fitting absorbed
+  // (PlaneFittingOptions::extend_to_absorbed) or over what plane growth
+  // added; empty otherwise (then it is `polygon`).
   Polygon2d landmark_polygon;
   // RMS point-to-plane distance of the inliers (m).
   double rms_distance_m = 0.0;
@@ -96,8 +98,9 @@ struct TexturedPlane {
   cv::Mat texture;
   // Extent as a polygon of (s, t) plane coordinates in metres.
   Polygon2d polygon;
-  // The polygon its landmarks support (the fitted one), when plane growth
-  // changed `polygon`; empty otherwise. Localization renders only this
+  // The polygon its inliers support, when `polygon` reaches further (over
+  // absorbed points or grown cells: PlaneSegment::landmark_polygon); empty
+  // otherwise. Localization renders only this
   // (RendererOptions::clip_to_landmark_polygon).
   Polygon2d landmark_polygon;
   std::vector<PlaneFeature> features;

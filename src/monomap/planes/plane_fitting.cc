@@ -50,6 +50,8 @@ void PlaneFittingOptions::Check() const {
               "planes.tracking_noise_px", "must be finite and >= 0");
   CheckOption(covariance_sigmas >= 0 && std::isfinite(covariance_sigmas),
               "planes.covariance_sigmas", "must be finite and >= 0");
+  CheckOption(max_extension_rounds >= 1, "planes.max_extension_rounds",
+              "must be >= 1");
   CheckOption(polygon_cell_factor > 0, "planes.polygon_cell_factor",
               "must be > 0");
   CheckOption(snap_max_angle_deg >= 0 && snap_max_angle_deg < 90,
@@ -425,21 +427,39 @@ std::vector<std::vector<int>> SplitRegions(const FitState& s,
 }
 
 // Marks remaining outliers consistent with `seg` (within their uncertainty
-// and near its polygon) as taken, so no later plane claims them.
-void AbsorbConsistent(const PlaneSegment& seg, double radius, FitState* s) {
-  const double k = s->options.covariance_sigmas * s->options.tracking_noise_px;
-  for (int lm : s->remaining) {
-    if (s->taken[lm]) continue;
-    const Eigen::Vector3d& x = s->lms[lm].x_in_world;
-    const double band = std::max(
-        s->thresholds[lm], CovarianceBand(s->lms[lm], seg.plane.normal, k));
-    if (std::abs(seg.plane.SignedDistance(x)) > band) continue;
-    const Eigen::Vector2d q = seg.frame.ToPlane(x);
-    if (DistanceToPolygon(seg.polygon, q) <= radius) {
-      s->taken[lm] = 1;
-      ++s->report->absorbed;
+// and near its polygon) as taken, so no later plane claims them. With
+// extend_to_absorbed they also bound it: the polygon is redrawn over the
+// inliers and the absorbed points, which brings the next ones within
+// reach, for up to max_extension_rounds rounds; the inliers' own outline
+// stays as landmark_polygon.
+void AbsorbConsistent(double radius, FitState* s, PlaneSegment* seg) {
+  const PlaneFittingOptions& o = s->options;
+  const double k = o.covariance_sigmas * o.tracking_noise_px;
+  const Polygon2d fitted = seg->polygon;
+  std::vector<Eigen::Vector2d> support = seg->inlier_st;
+  const int rounds = o.extend_to_absorbed ? o.max_extension_rounds : 1;
+  for (int round = 0; round < rounds; ++round) {
+    const size_t before = support.size();
+    for (int lm : s->remaining) {
+      if (s->taken[lm]) continue;
+      const Eigen::Vector3d& x = s->lms[lm].x_in_world;
+      const double band = std::max(
+          s->thresholds[lm], CovarianceBand(s->lms[lm], seg->plane.normal, k));
+      if (std::abs(seg->plane.SignedDistance(x)) > band) continue;
+      const Eigen::Vector2d q = seg->frame.ToPlane(x);
+      if (DistanceToPolygon(seg->polygon, q) <= radius) {
+        s->taken[lm] = 1;
+        ++s->report->absorbed;
+        support.push_back(q);
+      }
     }
+    if (!o.extend_to_absorbed || support.size() == before) break;
+    seg->polygon =
+        o.concave_polygon
+            ? OccupancyOutline(support, o.polygon_cell_factor * radius)
+            : ConvexHull(support);
   }
+  if (seg->polygon != fitted) seg->landmark_polygon = fitted;
 }
 
 // The plane of a segment's points: least squares, snapped to the scene's
@@ -508,7 +528,7 @@ void AddSegment(const std::vector<size_t>& inliers,
                                        s->options.polygon_cell_factor * radius)
                     : ConvexHull(seg.inlier_st);
   s->report->inliers_per_plane.push_back(static_cast<int>(comp.size()));
-  if (s->options.absorb_consistent_points) AbsorbConsistent(seg, radius, s);
+  if (s->options.absorb_consistent_points) AbsorbConsistent(radius, s, &seg);
   s->segments->push_back(std::move(seg));
 }
 
@@ -590,17 +610,28 @@ double MedianDistance(const Plane& plane,
 }
 
 // Smallest distance between the polygons of a and b, in a's plane.
-double PolygonGap(const PlaneSegment& a, const PlaneSegment& b) {
+// Smallest in-plane distance between polygon pa of segment a and pb of b.
+double PolygonGap(const PlaneSegment& a, const Polygon2d& pa,
+                  const PlaneSegment& b, const Polygon2d& pb) {
   double gap = std::numeric_limits<double>::infinity();
-  for (const Eigen::Vector2d& v : b.polygon) {
-    gap = std::min(
-        gap, DistanceToPolygon(a.polygon, a.frame.ToPlane(b.frame.ToWorld(v))));
+  for (const Eigen::Vector2d& v : pb) {
+    gap = std::min(gap,
+                   DistanceToPolygon(pa, a.frame.ToPlane(b.frame.ToWorld(v))));
   }
-  for (const Eigen::Vector2d& v : a.polygon) {
-    gap = std::min(
-        gap, DistanceToPolygon(b.polygon, b.frame.ToPlane(a.frame.ToWorld(v))));
+  for (const Eigen::Vector2d& v : pa) {
+    gap = std::min(gap,
+                   DistanceToPolygon(pb, b.frame.ToPlane(a.frame.ToWorld(v))));
   }
   return gap;
+}
+
+double PolygonGap(const PlaneSegment& a, const PlaneSegment& b) {
+  return PolygonGap(a, a.polygon, b, b.polygon);
+}
+
+// What a segment's inliers support: its polygon unless that was extended.
+const Polygon2d& SupportedPolygon(const PlaneSegment& seg) {
+  return seg.landmark_polygon.empty() ? seg.polygon : seg.landmark_polygon;
 }
 
 // A segment while merging: its inlier positions and its id as fitted.
@@ -655,19 +686,40 @@ bool SameSurface(const FitState& s, const PlaneSegment& a, const MergeItem& ia,
   return *gap <= o.merge_max_gap_m;
 }
 
-// The polygon's vertices in world coordinates.
-std::vector<Eigen::Vector3d> PolygonInWorld(const PlaneSegment& seg) {
+// A polygon of `seg` in world coordinates.
+std::vector<Eigen::Vector3d> InWorld(const PlaneSegment& seg,
+                                     const Polygon2d& polygon) {
   std::vector<Eigen::Vector3d> out;
-  for (const Eigen::Vector2d& v : seg.polygon) out.push_back(seg.frame.ToWorld(v));
+  for (const Eigen::Vector2d& v : polygon) out.push_back(seg.frame.ToWorld(v));
   return out;
 }
 
+// World polygons in `seg`'s plane coordinates.
+std::vector<Polygon2d> InPlane(
+    const PlaneSegment& seg,
+    const std::vector<std::vector<Eigen::Vector3d>>& outlines) {
+  std::vector<Polygon2d> polygons(outlines.size());
+  for (size_t i = 0; i < outlines.size(); ++i) {
+    for (const Eigen::Vector3d& x : outlines[i]) {
+      polygons[i].push_back(seg.frame.ToPlane(x));
+    }
+  }
+  return polygons;
+}
+
 // Refits a (plane, frame, in-plane coordinates) to the points of a and b
-// and bounds it by the union of their polygons, bridging `gap`.
+// and bounds it by the union of their polygons, bridging `gap`; the same
+// for what their inliers support, if either was extended.
 void MergeInto(const MergeItem& item, const PlaneSegment& b, double gap,
                FitState* s, PlaneSegment* a) {
   const std::vector<std::vector<Eigen::Vector3d>> outlines = {
-      PolygonInWorld(*a), PolygonInWorld(b)};
+      InWorld(*a, a->polygon), InWorld(b, b.polygon)};
+  const bool extended =
+      !a->landmark_polygon.empty() || !b.landmark_polygon.empty();
+  const double supported_gap =
+      PolygonGap(*a, SupportedPolygon(*a), b, SupportedPolygon(b));
+  const std::vector<std::vector<Eigen::Vector3d>> supported = {
+      InWorld(*a, SupportedPolygon(*a)), InWorld(b, SupportedPolygon(b))};
   a->inlier_ids.insert(a->inlier_ids.end(), b.inlier_ids.begin(),
                        b.inlier_ids.end());
   a->plane = FitSegmentPlane(item.pts, item.lms, a->id, /*learn=*/false, s);
@@ -677,13 +729,11 @@ void MergeInto(const MergeItem& item, const PlaneSegment& b, double gap,
   for (size_t k = 0; k < item.pts.size(); ++k) {
     a->inlier_st[k] = a->frame.ToPlane(item.pts[k]);
   }
-  std::vector<Polygon2d> polygons(outlines.size());
-  for (size_t i = 0; i < outlines.size(); ++i) {
-    for (const Eigen::Vector3d& x : outlines[i]) {
-      polygons[i].push_back(a->frame.ToPlane(x));
-    }
+  a->polygon = MergedOutline(InPlane(*a, outlines), gap);
+  a->landmark_polygon.clear();
+  if (extended) {
+    a->landmark_polygon = MergedOutline(InPlane(*a, supported), supported_gap);
   }
-  a->polygon = MergedOutline(polygons, gap);
 }
 
 // Merges the first pair of segments that are one surface; false if none.

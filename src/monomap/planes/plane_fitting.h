@@ -77,6 +77,16 @@ struct PlaneFittingOptions {
   // are loose along their rays, beyond the depth-scaled threshold, and
   // would otherwise gather into tilted "ghost" planes of a real one.
   bool absorb_consistent_points = true;
+  // The absorbed points also bound the segment: its polygon is redrawn over
+  // its inliers and them, which brings more within reach, round after
+  // round. On plain or grazing stretches of a wall the points are too loose
+  // to fit the plane but still show where it extends. The inliers' own
+  // outline is kept as PlaneSegment::landmark_polygon (what localization
+  // renders).
+  bool extend_to_absorbed = true;
+  // Rounds of that extension (each reaches about one connectivity radius
+  // further).
+  int max_extension_rounds = 20;
   // Effective noise of a tracked position (px), drift included, scaling the
   // landmark covariance.
   double tracking_noise_px = 1.0;

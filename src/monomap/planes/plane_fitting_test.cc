@@ -754,3 +754,84 @@ TEST(FitPlanes, WallStripFromFewLoosePointsSnapsUpright) {
 }
 
 }  // namespace monomap
+
+namespace monomap {
+namespace {
+
+// A floor whose near half has tight points (on it within 2 mm) and whose
+// far half only loose ones: 1.5-3.5 cm above or below it, beyond their 1 cm
+// fitting threshold but within their uncertainty (5 cm along rays 15 deg
+// below the horizontal); and, 0.5 m past it, loose points of a shelf 20 cm
+// up.
+std::vector<Landmark> FloorWithLooseFarHalf(uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> uni(0.0, 1.0);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  const Eigen::Vector3d ray(std::cos(15 * kPi / 180), 0,
+                            -std::sin(15 * kPi / 180));
+  const Eigen::Matrix3d tight = 1e-6 * Eigen::Matrix3d::Identity();
+  const Eigen::Matrix3d loose = 0.05 * 0.05 * ray * ray.transpose() + tight;
+  std::vector<Landmark> lms;
+  auto push = [&](double x0, double x1, double z, double off,
+                  const Eigen::Matrix3d& cov, int n) {
+    for (int i = 0; i < n; ++i) {
+      Landmark l;
+      l.id = static_cast<FeatureId>(lms.size());
+      const double dz =
+          off > 0 ? (uni(rng) < 0.5 ? -1 : 1) * (off - 0.01 + 0.02 * uni(rng))
+                  : 0.002 * noise(rng);
+      l.x_in_world = {x0 + (x1 - x0) * uni(rng), 2.0 * uni(rng), z + dz};
+      l.mean_depth_m = 1.0;
+      l.covariance_m2_per_px2 = cov;
+      lms.push_back(l);
+    }
+  };
+  push(0.0, 2.0, 0.0, 0.0, tight, 500);
+  push(2.0, 4.0, 0.0, 0.025, loose, 400);
+  push(4.5, 5.5, 0.2, 0.0, loose, 200);
+  return lms;
+}
+
+TEST(FitPlanes, LooseConsistentPointsExtendThePolygon) {
+  const std::vector<Eigen::Vector3d> cameras = {{-1.0, 1.0, 0.5}};
+  PlaneFittingOptions options;
+  auto floor_extent = [&](bool extend, PlaneSegment* floor) {
+    options.extend_to_absorbed = extend;
+    std::vector<Landmark> lms = FloorWithLooseFarHalf(3);
+    std::vector<PlaneSegment> segments;
+    FitPlanes(options, &lms, &segments, &cameras);
+    for (const PlaneSegment& s : segments) {
+      if (std::abs(s.plane.normal.z()) > 0.99 &&
+          std::abs(s.plane.offset) < 0.01)
+        *floor = s;
+    }
+    double x_max = -1e9;
+    for (const Eigen::Vector2d& v : floor->polygon) {
+      x_max = std::max(x_max, floor->frame.ToWorld(v).x());
+    }
+    return x_max;
+  };
+  PlaneSegment fitted, extended;
+  const double fitted_x = floor_extent(false, &fitted);
+  const double extended_x = floor_extent(true, &extended);
+  // Inliers only: the tight half; extended: over the loose half too, but
+  // not across the gap onto the shelf 20 cm up.
+  EXPECT_NEAR(fitted_x, 2.0, 0.15);
+  EXPECT_TRUE(fitted.landmark_polygon.empty());
+  EXPECT_GT(extended_x, 3.8);
+  EXPECT_LT(extended_x, 4.3);
+  // The plane itself is still the tight points' and the inliers' outline is
+  // kept for localization.
+  EXPECT_LT(PlaneAngle(extended.plane, fitted.plane), 1e-9);
+  EXPECT_EQ(extended.inlier_ids.size(), fitted.inlier_ids.size());
+  double supported_x = -1e9;
+  for (const Eigen::Vector2d& v : extended.landmark_polygon) {
+    supported_x = std::max(supported_x, extended.frame.ToWorld(v).x());
+  }
+  EXPECT_NEAR(supported_x, fitted_x, 1e-9);
+  options.max_extension_rounds = 0;
+  EXPECT_THROW(options.Check(), OptionsError);
+}
+
+}  // namespace
+}  // namespace monomap

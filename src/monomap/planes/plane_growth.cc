@@ -1022,9 +1022,15 @@ PlaneGrowthReport GrowPlanePolygons(
   std::stable_sort(order.begin(), order.end(),
                    [&](int a, int b) { return areas[a] > areas[b]; });
   std::vector<Polygon2d> original(segments->size());
+  // What the landmarks alone support: plane fitting's own landmark_polygon
+  // if it extended the polygon over absorbed points, else the polygon.
+  std::vector<Polygon2d> supported(segments->size());
   std::vector<SegmentGrid> grids(segments->size());
   for (size_t i = 0; i < segments->size(); ++i) {
     original[i] = (*segments)[i].polygon;
+    supported[i] = (*segments)[i].landmark_polygon.empty()
+                       ? original[i]
+                       : (*segments)[i].landmark_polygon;
     grids[i] = PrepareGrid(options, (*segments)[i], views, projector,
                            world_from_cam, landmarks, track_by_id);
   }
@@ -1060,7 +1066,7 @@ PlaneGrowthReport GrowPlanePolygons(
   for (size_t i = 0; i < segments->size(); ++i) {
     PlaneSegment& seg = (*segments)[i];
     seg.landmark_polygon.clear();
-    if (seg.polygon != original[i]) seg.landmark_polygon = original[i];
+    if (seg.polygon != supported[i]) seg.landmark_polygon = supported[i];
   }
   ConfirmHypotheses(options, views, projector, world_from_cam, landmarks,
                     track_by_id, hypotheses, segments, &report);

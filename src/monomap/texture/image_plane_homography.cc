@@ -337,10 +337,17 @@ HomographyReport ComputeImagePlaneHomographies(
   std::vector<std::vector<Eigen::Vector2d>> samples(num_planes);
   std::vector<Eigen::Vector2d> centres(num_planes);
   for (int p = 0; p < num_planes; ++p) {
-    if (segments[p].polygon.size() < 3) continue;
-    samples[p] = PolygonSamples(segments[p].polygon, options.visibility_grid);
+    // Visibility and resolution are judged over what the plane's inliers
+    // support (landmark_polygon, where the polygon reaches further over
+    // loose points or grown cells): the views chosen for the texture and
+    // its resolution serve the part that localization renders.
+    const PlaneSegment& seg = segments[p];
+    const Polygon2d& region =
+        seg.landmark_polygon.size() >= 3 ? seg.landmark_polygon : seg.polygon;
+    if (seg.polygon.size() < 3 || region.size() < 3) continue;
+    samples[p] = PolygonSamples(region, options.visibility_grid);
     Eigen::Vector2d lo, hi;
-    PolygonBounds(segments[p].polygon, &lo, &hi);
+    PolygonBounds(region, &lo, &hi);
     centres[p] = 0.5 * (lo + hi);
   }
 
