@@ -113,6 +113,27 @@ std::vector<double> TrackErrors(const std::vector<Track>& tracks,
   return errors;
 }
 
+// Errors at the last frame of the tracks of >= 40 frames against the true
+// projection of where each started (`seq`: frames and Predict), tracked
+// with or without the affine alignment.
+template <typename Seq>
+std::vector<double> LastFrameErrors(const Seq& seq, bool affine) {
+  KltTrackerOptions options;
+  options.affine_refinement = affine;
+  KltTracker tracker(options);
+  for (size_t k = 0; k < seq.frames.size(); ++k) {
+    tracker.Track(static_cast<int>(k), seq.frames[k]);
+  }
+  std::vector<double> errors;
+  for (const Track& t : tracker.FinishedTracks(40)) {
+    const Observation& first = t.observations.front();
+    const Observation& last = t.observations.back();
+    errors.push_back(
+        (seq.Predict(first.frame, first.px, last.frame) - last.px).norm());
+  }
+  return errors;
+}
+
 TEST(KltTrackerTest, SubPixelAccuracyUnderAffineMotion) {
   const cv::Mat base = MakeTexture(1100, 900, 1);
   const Sequence seq = MakeSequence(base, 12, {0.73, -0.41, 0.25, 0.002});
@@ -143,22 +164,8 @@ TEST(KltTrackerTest, AffineRefinementRemovesDriftUnderZoom) {
   const cv::Mat base = MakeTexture(1000, 800, 7);
   constexpr int kFrames = 60;
   const Sequence seq = MakeSequence(base, kFrames, {0.3, 0.2, 0.3, 0.01});
-  auto last_frame_errors = [&](bool affine) {
-    KltTrackerOptions options;
-    options.affine_refinement = affine;
-    KltTracker tracker(options);
-    for (int k = 0; k < kFrames; ++k) tracker.Track(k, seq.frames[k]);
-    std::vector<double> errors;
-    for (const Track& t : tracker.FinishedTracks(40)) {
-      const Observation& first = t.observations.front();
-      const Observation& last = t.observations.back();
-      errors.push_back(
-          (seq.Predict(first.frame, first.px, last.frame) - last.px).norm());
-    }
-    return errors;
-  };
-  const std::vector<double> plain = last_frame_errors(false);
-  const std::vector<double> refined = last_frame_errors(true);
+  const std::vector<double> plain = LastFrameErrors(seq, false);
+  const std::vector<double> refined = LastFrameErrors(seq, true);
   ASSERT_GT(plain.size(), 100u);
   ASSERT_GT(refined.size(), 100u);
   const double plain_median = Percentile(plain, 0.5);
@@ -238,22 +245,8 @@ TEST(KltTrackerTest, LittleDriftOnAWallPassedAtGrazingAngles) {
   const cv::Mat texture = MakeTexture(3200, 800, 11);
   constexpr int kFrames = 60;
   const WallSequence seq = MakeWallSequence(texture, kFrames, 0.8, 15.0, 0.02);
-  auto last_frame_errors = [&](bool affine) {
-    KltTrackerOptions options;
-    options.affine_refinement = affine;
-    KltTracker tracker(options);
-    for (int k = 0; k < kFrames; ++k) tracker.Track(k, seq.frames[k]);
-    std::vector<double> errors;
-    for (const Track& t : tracker.FinishedTracks(40)) {
-      const Observation& first = t.observations.front();
-      const Observation& last = t.observations.back();
-      errors.push_back(
-          (seq.Predict(first.frame, first.px, last.frame) - last.px).norm());
-    }
-    return errors;
-  };
-  const std::vector<double> plain = last_frame_errors(false);
-  const std::vector<double> refined = last_frame_errors(true);
+  const std::vector<double> plain = LastFrameErrors(seq, false);
+  const std::vector<double> refined = LastFrameErrors(seq, true);
   ASSERT_GT(refined.size(), 200u);
   std::printf(
       "grazing wall, tracks of >= 40 frames, error at their last frame: "
