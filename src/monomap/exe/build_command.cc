@@ -230,6 +230,9 @@ void AddGrowthOptions(CLI::App* cmd, BuildArgs* a) {
   cmd->add_flag("!--plane-growth-no-aperture-test", o.growth.aperture_test,
                 "Count a textured cell as evidence even when its texture does "
                 "not change along the direction the views' parallax moves it");
+  cmd->add_flag("!--plane-growth-redraw-fitted", o.growth.keep_fitted_outline,
+                "Redraw a grown plane's whole polygon as growth's cells "
+                "instead of adding the grown cells to its points' polygon");
   cmd->add_flag("!--plane-growth-keep-hidden", o.growth.drop_hidden_cells,
                 "Keep the cells of a plane's points' polygon that every view "
                 "sees only through a plane meeting it (left out by default)");

@@ -5,6 +5,8 @@
 #include <opencv2/imgproc.hpp>
 #include <vector>
 
+#include "monomap/util/error.h"
+
 namespace monomap {
 
 Polygon2d OutlineOfCells(const cv::Mat1b& cells, const Eigen::Vector2d& lo,
@@ -45,6 +47,33 @@ Polygon2d OutlineOfCells(const cv::Mat1b& cells, const Eigen::Vector2d& lo,
   }
   if (PolygonArea(poly) < 0) std::reverse(poly.begin(), poly.end());
   return poly;
+}
+
+Polygon2d OutlineOfPolygonAndCells(const Polygon2d& polygon,
+                                   const cv::Mat1b& added,
+                                   const cv::Mat1b& removed,
+                                   const Eigen::Vector2d& lo, double cell,
+                                   int fine) {
+  if (added.size() != removed.size() || fine < 1 || !(cell > 0)) {
+    throw StageError(
+        "OutlineOfPolygonAndCells: grids of different sizes, fine < 1 or "
+        "cell <= 0");
+  }
+  const double step = cell / fine;
+  cv::Mat1b cells(added.rows * fine, added.cols * fine, uint8_t{0});
+  for (int r = 0; r < cells.rows; ++r) {
+    for (int c = 0; c < cells.cols; ++c) {
+      const int gr = r / fine, gc = c / fine;
+      if (added(gr, gc)) {
+        cells(r, c) = 1;
+      } else if (!removed(gr, gc)) {
+        const Eigen::Vector2d st =
+            lo + step * Eigen::Vector2d(c + 0.5, r + 0.5);
+        cells(r, c) = PointInPolygon(polygon, st) ? 1 : 0;
+      }
+    }
+  }
+  return OutlineOfCells(cells, lo, step, 0);
 }
 
 }  // namespace monomap

@@ -760,6 +760,47 @@ GrowthCellMap MapCells(const Grid& grid, const cv::Mat1b& fitted,
   return map;
 }
 
+// The member cells (0/1) as 0/255, holes and notches up to close_cells
+// closed.
+cv::Mat1b ClosedCells(const PlaneGrowthOptions& o, const cv::Mat1b& member) {
+  cv::Mat1b cells = member * 255;
+  if (o.close_cells > 0) {
+    const int k = 2 * o.close_cells + 1;
+    cv::morphologyEx(cells, cells, cv::MORPH_CLOSE,
+                     cv::getStructuringElement(cv::MORPH_RECT, {k, k}));
+  }
+  return cells;
+}
+
+// The outline of the member cells, closed.
+Polygon2d GrownCellsOutline(const PlaneGrowthOptions& o, const Grid& grid,
+                            const cv::Mat1b& member) {
+  return OutlineOfCells(ClosedCells(o, member), grid.lo, grid.cell, 0);
+}
+
+// The fitted polygon as drawn, less the cells found hidden (kept: the
+// fitted cells left) and its slivers beside them (cells whose centres it
+// misses), plus the cells growth added and the gaps closed next to them.
+// Redrawing the fitted polygon as whole cells would widen it by up to half
+// a cell, and closing would join its spikes, where a misplaced point may
+// have pulled it past the foot of a wall the map lacks.
+Polygon2d FittedAndGrownOutline(const PlaneGrowthOptions& o,
+                                const PlaneSegment& seg, const SegmentGrid& g,
+                                const cv::Mat1b& kept,
+                                const cv::Mat1b& member) {
+  const cv::Mat1b box = cv::getStructuringElement(cv::MORPH_RECT, {3, 3});
+  cv::Mat1b near_grown;
+  cv::dilate(member & ~g.inside, near_grown, box);
+  const cv::Mat1b closed = ClosedCells(o, member);
+  const cv::Mat1b hidden = g.inside & ~kept;
+  cv::Mat1b beside_hidden;
+  cv::dilate(hidden, beside_hidden, box);
+  return OutlineOfPolygonAndCells(
+      seg.polygon, (closed & near_grown) & ~g.inside,
+      hidden | (beside_hidden & ~g.inside), g.grid.lo, g.grid.cell,
+      /*fine=*/3);
+}
+
 // Grows one segment (its fitted polygon) against the others (occluders).
 // Returns the new polygon, or the fitted one if nothing grew. With
 // `hypothesis`, the segment is a plane hypothesis: only the cells of its
@@ -802,14 +843,13 @@ Polygon2d GrowSegment(const PlaneGrowthOptions& o, const PlaneSegment& seg,
   const bool grew =
       stats->cells_textured + stats->cells_plain + stats->cells_hidden > 0;
   if (!grew && hypothesis == nullptr) return seg.polygon;
-  member *= 255;
-  if (o.close_cells > 0) {
-    const int k = 2 * o.close_cells + 1;
-    cv::morphologyEx(member, member, cv::MORPH_CLOSE,
-                     cv::getStructuringElement(cv::MORPH_RECT, {k, k}));
+  if (hypothesis != nullptr) {
+    Polygon2d poly = GrownCellsOutline(o, grid, member);
+    return poly.size() >= 3 ? poly : Polygon2d{};
   }
-  Polygon2d poly = OutlineOfCells(member, grid.lo, grid.cell, 0);
-  if (hypothesis != nullptr) return poly.size() >= 3 ? poly : Polygon2d{};
+  Polygon2d poly = o.keep_fitted_outline
+                       ? FittedAndGrownOutline(o, seg, g, inside, member)
+                       : GrownCellsOutline(o, grid, member);
   return poly.size() >= 3 ? poly : seg.polygon;
 }
 

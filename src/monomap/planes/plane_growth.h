@@ -46,8 +46,7 @@ namespace monomap {
 struct PlaneGrowthOptions {
   // Grow polygons at all (the polygon before growth is kept as
   // PlaneSegment::landmark_polygon, which localization renders). Off by
-  // default: on small maps grown areas can reach over a neighbouring
-  // surface (docs/design-notes.md, "Planes").
+  // default (docs/design-notes.md, "Planes").
   bool enabled = false;
   // Cell side in image pixels at the plane's median view resolution, so the
   // grid is scale-free (a desk and a hallway get the same image support).
@@ -128,6 +127,9 @@ struct PlaneGrowthOptions {
   double min_occluder_cells = 4.0;
   // Holes and notches up to this many cells are closed in the outline.
   int close_cells = 1;
+  // Keep the fitted polygon's own outline and add the grown cells to it,
+  // rather than redraw the whole polygon as growth's cells.
+  bool keep_fitted_outline = true;
   // A plane hypothesis (plane_hypotheses.h) is kept when at least this
   // many cells over its landmarks' hull correlate across the views ...
   int hypothesis_min_textured_cells = 4;
