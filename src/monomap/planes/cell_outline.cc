@@ -61,18 +61,28 @@ Polygon2d OutlineOfPolygonAndCells(const Polygon2d& polygon,
   }
   const double step = cell / fine;
   cv::Mat1b cells(added.rows * fine, added.cols * fine, uint8_t{0});
-  for (int r = 0; r < cells.rows; ++r) {
-    for (int c = 0; c < cells.cols; ++c) {
-      const int gr = r / fine, gc = c / fine;
-      if (added(gr, gc)) {
-        cells(r, c) = 1;
-      } else if (!removed(gr, gc)) {
-        const Eigen::Vector2d st =
-            lo + step * Eigen::Vector2d(c + 0.5, r + 0.5);
-        cells(r, c) = PointInPolygon(polygon, st) ? 1 : 0;
-      }
+  // The polygon is tested only over its bounds (exact centre-in-polygon:
+  // cv::fillPoly also fills the pixels its edges touch).
+  Eigen::Vector2d plo(0, 0), phi(-1, -1);
+  if (!polygon.empty()) PolygonBounds(polygon, &plo, &phi);
+  const int c0 =
+      std::max(0, static_cast<int>(std::floor((plo.x() - lo.x()) / step)));
+  const int r0 =
+      std::max(0, static_cast<int>(std::floor((plo.y() - lo.y()) / step)));
+  const int c1 = std::min(
+      cells.cols - 1, static_cast<int>(std::ceil((phi.x() - lo.x()) / step)));
+  const int r1 = std::min(
+      cells.rows - 1, static_cast<int>(std::ceil((phi.y() - lo.y()) / step)));
+  for (int r = r0; r <= r1; ++r) {
+    for (int c = c0; c <= c1; ++c) {
+      if (removed(r / fine, c / fine)) continue;
+      const Eigen::Vector2d st = lo + step * Eigen::Vector2d(c + 0.5, r + 0.5);
+      cells(r, c) = PointInPolygon(polygon, st) ? 1 : 0;
     }
   }
+  cv::Mat1b fine_added;  // nearest at an integer factor: fine r is r / fine
+  cv::resize(added, fine_added, cells.size(), 0, 0, cv::INTER_NEAREST);
+  cells.setTo(1, fine_added);
   return OutlineOfCells(cells, lo, step, 0);
 }
 
