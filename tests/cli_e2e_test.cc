@@ -428,7 +428,7 @@ TEST_F(Cli, InlierRefinementBringsTheExportedPointsCloserToTheSurfaces) {
   EXPECT_LT(median[0], 0.8 * median[1]);
 }
 
-// build --grow-planes --debug-growth DIR: an image and the verdict counts
+// build --debug-growth DIR: an image and the verdict counts
 // per plane; a grown plane's grown cells carry the verdicts they joined on
 // (textured: as many as the build report counts; for a plane without
 // hypothesis cells).
@@ -438,8 +438,8 @@ TEST_F(Cli, DebugGrowthWritesEachPlanesCellVerdicts) {
   const fs::path dir = *root_ / "growth_cells";
   const fs::path report = *root_ / "debug_growth_report.json";
   RunResult r = RunMonomap("build " + data.string() + " -o " + map.string() +
-                           " -q --grow-planes --debug-growth " + dir.string() +
-                           " --report " + report.string());
+                           " -q --debug-growth " + dir.string() + " --report " +
+                           report.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   std::ifstream cells_in(dir / "cells.json");
   const nlohmann::json cells = nlohmann::json::parse(cells_in);
@@ -471,16 +471,17 @@ TEST_F(Cli, DebugGrowthWritesEachPlanesCellVerdicts) {
   }
   EXPECT_GT(grown, 0);
   // Without growth there is nothing to show: refused before any work.
-  r = RunMonomap("build " + data.string() + " -o " +
-                 (*root_ / "map_x").string() + " -q --debug-growth " +
-                 (*root_ / "cells_x").string());
+  r = RunMonomap(
+      "build " + data.string() + " -o " + (*root_ / "map_x").string() +
+      " -q --no-grow-planes --debug-growth " + (*root_ / "cells_x").string());
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.output.find("--debug-growth"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(*root_ / "map_x"));
 }
 
-// build --grow-planes: the planes grow beyond
-// their points over what the images explain; the report says by how much,
+// build (growth is the default) against build --no-grow-planes: the planes
+// grow beyond their points over what the images explain, and plane
+// hypotheses (--plane-hypotheses) are checked; the report says by how much,
 // more of the world's seen structure is recovered while the grown area
 // stays on it, and the map keeps what the points support for localization.
 TEST_F(Cli, GrowPlanesRecoversMoreOfTheSeenStructure) {
@@ -489,9 +490,9 @@ TEST_F(Cli, GrowPlanesRecoversMoreOfTheSeenStructure) {
   for (int grow = 0; grow < 2; ++grow) {
     const fs::path map = *root_ / ("map_grow" + std::to_string(grow));
     const fs::path report = *root_ / ("grow_report" + std::to_string(grow) + ".json");
-    RunResult r = RunMonomap("build " + data.string() + " -o " + map.string() +
-                             " -q --report " + report.string() +
-                             (grow ? " --grow-planes" : ""));
+    RunResult r = RunMonomap(
+        "build " + data.string() + " -o " + map.string() + " -q --report " +
+        report.string() + (grow ? " --plane-hypotheses" : " --no-grow-planes"));
     ASSERT_EQ(r.exit_code, 0) << r.output;
     std::ifstream report_in(report);
     const nlohmann::json build_report = nlohmann::json::parse(report_in);

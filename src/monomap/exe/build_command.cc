@@ -30,9 +30,11 @@ struct BuildArgs {
   bool no_affine = false;
   bool no_merge_coplanar = false;
   bool no_see_through = false;
-  bool grow_planes = false;
+  bool no_grow_planes = false;
+  bool grow_planes = false;  // the default; kept for older scripts
   std::string debug_growth;  // --debug-growth DIR
-  bool no_plane_hypotheses = false;
+  bool plane_hypotheses = false;
+  bool no_plane_hypotheses = false;  // the default; kept for older scripts
   bool no_direction_snap = false;
   bool quiet = false;
   bool drop_odometry_jumps = false;
@@ -181,21 +183,28 @@ void AddPointTrustOptions(CLI::App* cmd, PointTrustOptions* o,
       ->capture_default_str();
 }
 
-// Plane growth (opt-in) and the plane hypotheses it checks.
+// Plane growth and the plane hypotheses (opt-in) it checks.
 void AddGrowthOptions(CLI::App* cmd, BuildArgs* a) {
   MappingOptions& o = a->options;
+  CLI::Option* no_grow = cmd->add_flag(
+      "--no-grow-planes", a->no_grow_planes,
+      "Bound each plane by its points only: do not grow its polygon over "
+      "the image regions its plane explains (photo-consistent across views)");
   cmd->add_flag("--grow-planes", a->grow_planes,
-                "Grow each plane's polygon over the image regions its plane "
-                "explains (photo-consistent across views), beyond its "
-                "points; localization renders only what the points support");
+                "Grow planes over what the images explain (the default; "
+                "kept for older scripts)")
+      ->excludes(no_grow);
   cmd->add_option("--debug-growth", a->debug_growth,
-                  "With --grow-planes: write why each cell of each plane "
-                  "did or did not join it (an image per plane and "
-                  "cells.json) to this directory");
+                  "Write why each cell of each plane did or did not join it "
+                  "(an image per plane and cells.json) to this directory");
+  CLI::Option* hypotheses = cmd->add_flag(
+      "--plane-hypotheses", a->plane_hypotheses,
+      "Also propose planes along the scene's directions through the points "
+      "on no plane, kept only where the images confirm them");
   cmd->add_flag("--no-plane-hypotheses", a->no_plane_hypotheses,
-                "With --grow-planes: do not propose planes along the scene's "
-                "directions through the points on no plane (kept only where "
-                "the images confirm them)");
+                "Propose no plane hypotheses (the default; kept for older "
+                "scripts)")
+      ->excludes(hypotheses);
   cmd->add_option("--plane-growth-plain-run", o.growth.max_plain_run,
                   "Grown planes extend over plain (untextured) cells at "
                   "most this many cells from texture evidence")
@@ -318,7 +327,8 @@ void RunBuild(const BuildArgs& a) {
   }
   if (!a.html.empty()) CheckOutputFile(a.html, {a.dataset, a.output}, "--html");
   if (!a.debug_growth.empty()) {
-    CheckOption(a.grow_planes, "--debug-growth", "needs --grow-planes");
+    CheckOption(!a.no_grow_planes, "--debug-growth",
+                "cannot be combined with --no-grow-planes");
     CheckOutputDirectory(a.debug_growth, "growth-debug", {a.dataset, a.output},
                          "--debug-growth");
   }
@@ -341,9 +351,9 @@ void RunBuild(const BuildArgs& a) {
   options.tracking.affine_refinement = !a.no_affine;
   options.planes.merge_coplanar = !a.no_merge_coplanar;
   options.see_through.enabled = !a.no_see_through;
-  options.growth.enabled = a.grow_planes;
+  options.growth.enabled = !a.no_grow_planes;
   options.growth.keep_cell_maps = !a.debug_growth.empty();
-  options.hypotheses.enabled = !a.no_plane_hypotheses;
+  options.hypotheses.enabled = a.plane_hypotheses;
   options.planes.snap_to_directions = !a.no_direction_snap;
   options.show_progress = !a.quiet;
   const MappingResult result = BuildMap(dataset, options);

@@ -119,7 +119,7 @@ TEST(DemoReportTest, SmallHallwayDemo) {
 // solid band over the wall's foot (NCC median 0.83).
 TEST(DemoReportTest, GrownPlanesKeepTheSmallDemosTextureFidelity) {
   DemoOptions o = SmallDemo("monomap_demo_grow_test");
-  o.mapping.growth.enabled = true;
+  ASSERT_TRUE(o.mapping.growth.enabled);  // the default
   const DemoReport r = RunDemo(o);
   int grown = 0;
   for (const auto& p : r.mapping["plane_growth"]["planes"]) {

@@ -45,9 +45,8 @@ namespace monomap {
 
 struct PlaneGrowthOptions {
   // Grow polygons at all (the polygon before growth is kept as
-  // PlaneSegment::landmark_polygon, which localization renders). Off by
-  // default (docs/design-notes.md, "Planes").
-  bool enabled = false;
+  // PlaneSegment::landmark_polygon, which localization renders).
+  bool enabled = true;
   // Cell side in image pixels at the plane's median view resolution, so the
   // grid is scale-free (a desk and a hallway get the same image support).
   double cell_px = 12.0;

@@ -19,8 +19,9 @@ namespace monomap {
 
 struct PlaneHypothesisOptions {
   // Propose hypotheses at all; they are checked by plane growth, so they
-  // take effect only when it is enabled.
-  bool enabled = true;
+  // take effect only when it is enabled. Opt-in: a few loose points can
+  // confirm a wrong wall through a wide lens (docs/design-notes.md).
+  bool enabled = false;
   // Landmarks on no segment that a hypothesis needs (three fix a free
   // plane; a known direction leaves one unknown, and the rest guard
   // against chance alignments of clutter).
