@@ -64,7 +64,7 @@ double ShareInside(const Polygon2d& poly, double u0, double u1, double v0,
   return all > 0 ? static_cast<double>(in) / all : 0.0;
 }
 
-// Growth is opt-in (build --grow-planes).
+// Growth is the default; the tests say so explicitly.
 PlaneGrowthOptions GrowthOn() {
   PlaneGrowthOptions o;
   o.enabled = true;
