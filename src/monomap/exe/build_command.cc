@@ -225,6 +225,11 @@ void AddGrowthOptions(CLI::App* cmd, BuildArgs* a) {
                   "A cell's views must span at least this angle (deg)")
       ->check(CLI::Range(0.0, 89.0))
       ->capture_default_str();
+  cmd->add_option("--plane-growth-min-plain-parallax",
+                  o.growth.min_plain_parallax_deg,
+                  "A plain cell's views must span at least this angle (deg)")
+      ->check(CLI::Range(0.0, 89.0))
+      ->capture_default_str();
   cmd->add_option("--plane-growth-min-cos", o.growth.min_cos_view_angle,
                   "Views at grazing angles (|cos| to the plane's normal "
                   "below this) do not count for a cell")

@@ -35,6 +35,8 @@ void PlaneGrowthOptions::Check() const {
   CheckOption(min_views >= 2, "growth.min_views", "must be >= 2");
   CheckOption(min_parallax_deg >= 0 && min_parallax_deg < 90,
               "growth.min_parallax_deg", "must be in [0, 90)");
+  CheckOption(min_plain_parallax_deg >= 0 && min_plain_parallax_deg < 90,
+              "growth.min_plain_parallax_deg", "must be in [0, 90)");
   CheckOption(min_cos_view_angle >= 0 && min_cos_view_angle < 1,
               "growth.min_cos_view_angle", "must be in [0, 1)");
   CheckOption(min_texture_std >= 0, "growth.min_texture_std", "must be >= 0");
@@ -166,12 +168,21 @@ class CellJudge {
     const int nv = static_cast<int>(rays.size());
     CellVerdict unused;
     if (why == nullptr) why = &unused;
-    if (nv < o_.min_views || MaxAngleDeg(rays) < o_.min_parallax_deg) {
+    const double parallax = nv < 2 ? 0.0 : MaxAngleDeg(rays);
+    if (nv < o_.min_views ||
+        parallax < std::min(o_.min_parallax_deg, o_.min_plain_parallax_deg)) {
       *why = nv < o_.min_views ? CellVerdict::kFewViews
                                : CellVerdict::kLowParallax;
       return Evidence::kNone;
     }
     const Evidence e = Photometric(patches, rays, gains, n, ncc, why);
+    const double bar =
+        e == Evidence::kPlain ? o_.min_plain_parallax_deg : o_.min_parallax_deg;
+    if (parallax < bar) {
+      if (ncc != nullptr) *ncc = -1.0;
+      *why = CellVerdict::kLowParallax;
+      return Evidence::kNone;
+    }
     if (e == Evidence::kTextured && o_.aperture_test &&
         AlongParallaxOnly(r, c, seeing, rays, patches)) {
       if (ncc != nullptr) *ncc = -1.0;

@@ -442,6 +442,43 @@ TEST(PlaneGrowth, PlainCellsOnlyBridgeAndLandmarksBehindCarveFreeSpace) {
   EXPECT_NEAR(hi.x(), 1.7 + 3 * c, 1.0 * c);
 }
 
+// Parallax proves a textured cell's plane; a plain cell's test (equal
+// brightness) does not use it. With a parallax bar no view pair of the scene
+// reaches, plain cells still join (by default) and textured ones do not.
+TEST(PlaneGrowth, PlainCellsNeedNoParallaxTexturedOnesDo) {
+  PlaneGrowthOptions options = GrowthOn();
+  options.max_plain_run = 3;
+  options.plain_between_proofs = false;
+  options.min_parallax_deg = 80.0;
+  ASSERT_EQ(options.min_plain_parallax_deg, 0.0);
+  TestScene flat = Room();
+  for (cv::Mat& img : flat.images) img.setTo(cv::Scalar::all(128));
+  for (double plain_bar : {0.0, 80.0}) {
+    options.min_plain_parallax_deg = plain_bar;
+    std::vector<PlaneSegment> segments = {FrontWallPatch(flat, 0.0)};
+    const PlaneGrowthReport report =
+        GrowPlanePolygons(options, flat.camera, flat.world_from_cam, {}, {},
+                          Loader(flat), &segments);
+    if (plain_bar == 0.0) {
+      // Exactly max_plain_run rings around the patch's cells.
+      EXPECT_GT(report.planes[0].cells_plain, 20);
+      EXPECT_GT(report.planes[0].area_after_m2, 0.2);
+    } else {
+      EXPECT_EQ(report.planes[0].cells_plain, 0);
+      EXPECT_NEAR(report.planes[0].area_after_m2, 0.12, 1e-9);
+    }
+  }
+  // The textured wall: without the parallax to place them, its textured
+  // cells do not join.
+  const TestScene textured = Room();
+  options.min_plain_parallax_deg = 0.0;
+  std::vector<PlaneSegment> segments = {FrontWallPatch(textured, 0.0)};
+  const PlaneGrowthReport report =
+      GrowPlanePolygons(options, textured.camera, textured.world_from_cam, {},
+                        {}, Loader(textured), &segments);
+  EXPECT_EQ(report.planes[0].cells_textured, 0);
+}
+
 // Auto-exposure brightens and darkens whole frames. Flat grey frames
 // alternately 20 % darker and brighter than their median: plain cells
 // agree across the views only once each view's gain, estimated from the
@@ -502,6 +539,9 @@ TEST(PlaneGrowth, OptionsAreChecked) {
   EXPECT_THROW(o.Check(), OptionsError);
   o = PlaneGrowthOptions();
   o.min_ncc = 1.0;
+  EXPECT_THROW(o.Check(), OptionsError);
+  o = PlaneGrowthOptions();
+  o.min_plain_parallax_deg = -1.0;
   EXPECT_THROW(o.Check(), OptionsError);
 }
 
