@@ -27,6 +27,8 @@
 #include <vector>
 
 #include "monomap/pipelines/demo.h"
+#include "monomap/planes/plane_growth.h"
+#include "monomap/planes/plane_hypotheses.h"
 #include "monomap/sim/simulate.h"
 #include "monomap/util/file.h"
 #include "monomap/util/runtime.h"
@@ -45,6 +47,12 @@ struct SweepOptions {
   int particles = 1500;
   double focal_error = 0.01;    // given fx, fy = true x (1 + this)
   double k1_factor = 0.85;      // given k1 = true k1 x this
+  // Map variants that leave the lens alone, to see how much the figures
+  // move with them: plane growth, its plain cells' parallax bar, and the
+  // plane hypotheses.
+  bool grow_planes = PlaneGrowthOptions().enabled;
+  double plain_parallax_deg = PlaneGrowthOptions().min_plain_parallax_deg;
+  bool plane_hypotheses = PlaneHypothesisOptions().enabled;
   std::string out = "lens_sweep.json";
 };
 
@@ -66,6 +74,9 @@ Figures RunOnce(const SweepOptions& o, uint64_t world_seed, uint64_t filter,
   d.show_progress = false;
   d.given_camera = given;
   d.mapping.bundle_adjustment.intrinsics.enabled = given.has_value();
+  d.mapping.growth.enabled = o.grow_planes;
+  d.mapping.growth.min_plain_parallax_deg = o.plain_parallax_deg;
+  d.mapping.hypotheses.enabled = o.plane_hypotheses;
   d.localization.num_frames = o.localization_frames;
   d.localization.particles = o.particles;
   d.localization.filter_seed_offset = filter;
@@ -163,6 +174,11 @@ int main(int argc, char** argv) {
                  "Relative error of the given focal length");
   app.add_option("--k1-factor", o.k1_factor, "Given k1 over the true k1");
   app.add_option("--out", o.out, "JSON output file");
+  app.add_flag("!--no-grow-planes", o.grow_planes, "Maps without growth");
+  app.add_option("--plain-parallax", o.plain_parallax_deg,
+                 "Growth's parallax bar for plain cells (deg)");
+  app.add_flag("--plane-hypotheses", o.plane_hypotheses,
+               "Maps with plane hypotheses");
   return monomap::ParseAndRunSweep(app, argc, argv, "lens_sweep",
                                    [&] { return monomap::Run(o); });
 }

@@ -62,10 +62,11 @@ struct PlaneGrowthOptions {
   // ... whose rays to the cell's centre span at least this angle (deg):
   // without parallax every plane hypothesis is photo-consistent.
   double min_parallax_deg = 4.0;
-  // The same bar for plain cells (deg). None by default: their test
-  // (equal brightness) does not use parallax, and they join only between
-  // proofs (max_plain_run, plain_between_proofs).
-  double min_plain_parallax_deg = 0.0;
+  // The same bar for plain cells (deg). Their test (equal brightness) does
+  // not use parallax, and they join only between proofs (max_plain_run,
+  // plain_between_proofs), so 0 is sound; it stays opt-in for now
+  // (docs/design-notes.md, "Planes").
+  double min_plain_parallax_deg = 4.0;
   // Views at grazing angles (|cos(ray, normal)| below this) do not count.
   double min_cos_view_angle = 0.15;
   // A view's patch is textured if its standard deviation (grey levels) is
