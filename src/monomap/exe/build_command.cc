@@ -205,6 +205,19 @@ void AddGrowthOptions(CLI::App* cmd, BuildArgs* a) {
                 "Propose no plane hypotheses (the default; kept for older "
                 "scripts)")
       ->excludes(hypotheses);
+  cmd->add_option("--plane-hypothesis-offset-check",
+                  o.growth.hypothesis_offset_depth_fraction,
+                  "A plane hypothesis is kept only if the images prefer its "
+                  "offset to offsets this fraction of its distance nearer "
+                  "and farther (0: off)")
+      ->check(CLI::Range(0.0, 0.5))
+      ->capture_default_str();
+}
+
+// Plane growth's bars: which cells count as evidence, how far plain ones
+// reach.
+void AddGrowthTuningOptions(CLI::App* cmd, BuildArgs* a) {
+  MappingOptions& o = a->options;
   cmd->add_option("--plane-growth-plain-run", o.growth.max_plain_run,
                   "Grown planes extend over plain (untextured) cells at "
                   "most this many cells from texture evidence")
@@ -260,13 +273,6 @@ void AddGrowthOptions(CLI::App* cmd, BuildArgs* a) {
                 o.growth.compensate_exposure,
                 "Compare plain cells' brightness across views without each "
                 "view's exposure gain (estimated from the tracked features)");
-  cmd->add_option("--plane-hypothesis-offset-check",
-                  o.growth.hypothesis_offset_depth_fraction,
-                  "A plane hypothesis is kept only if the images prefer its "
-                  "offset to offsets this fraction of its distance nearer "
-                  "and farther (0: off)")
-      ->check(CLI::Range(0.0, 0.5))
-      ->capture_default_str();
 }
 
 void AddMappingOptions(CLI::App* cmd, BuildArgs* a) {
@@ -300,6 +306,7 @@ void AddMappingOptions(CLI::App* cmd, BuildArgs* a) {
                   "Largest angle (deg) a plane's normal is snapped by")
       ->capture_default_str();
   AddGrowthOptions(cmd, a);
+  AddGrowthTuningOptions(cmd, a);
   cmd->add_option("--keyframe-interval", o.keyframes.interval,
                   "Bundle-adjust every n-th frame (1: all frames)")
       ->capture_default_str();
