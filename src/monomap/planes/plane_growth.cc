@@ -168,7 +168,7 @@ class CellJudge {
     const int nv = static_cast<int>(rays.size());
     CellVerdict unused;
     if (why == nullptr) why = &unused;
-    const double parallax = nv < 2 ? 0.0 : MaxAngleDeg(rays);
+    const double parallax = MaxAngleDeg(rays);  // 0 for fewer than 2
     if (nv < o_.min_views ||
         parallax < std::min(o_.min_parallax_deg, o_.min_plain_parallax_deg)) {
       *why = nv < o_.min_views ? CellVerdict::kFewViews

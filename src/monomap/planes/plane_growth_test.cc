@@ -460,23 +460,34 @@ TEST(PlaneGrowth, PlainCellsNeedNoParallaxTexturedOnesDo) {
         GrowPlanePolygons(options, flat.camera, flat.world_from_cam, {}, {},
                           Loader(flat), &segments);
     if (plain_bar == 0.0) {
-      // Exactly max_plain_run rings around the patch's cells.
-      EXPECT_GT(report.planes[0].cells_plain, 20);
-      EXPECT_GT(report.planes[0].area_after_m2, 0.2);
+      // Exactly max_plain_run cells beyond the patch on either side.
+      const double c = report.planes[0].cell_m;
+      Eigen::Vector2d lo, hi;
+      PolygonBounds(segments[0].polygon, &lo, &hi);
+      EXPECT_GT(report.planes[0].cells_plain, 0);
+      EXPECT_NEAR(lo.x(), 1.3 - 3 * c, 1.0 * c);
+      EXPECT_NEAR(hi.x(), 1.7 + 3 * c, 1.0 * c);
     } else {
       EXPECT_EQ(report.planes[0].cells_plain, 0);
       EXPECT_NEAR(report.planes[0].area_after_m2, 0.12, 1e-9);
     }
   }
-  // The textured wall: without the parallax to place them, its textured
-  // cells do not join.
+  // The textured wall: its textured cells join at the default bar, and not
+  // without the parallax to place them.
   const TestScene textured = Room();
   options.min_plain_parallax_deg = 0.0;
-  std::vector<PlaneSegment> segments = {FrontWallPatch(textured, 0.0)};
-  const PlaneGrowthReport report =
-      GrowPlanePolygons(options, textured.camera, textured.world_from_cam, {},
-                        {}, Loader(textured), &segments);
-  EXPECT_EQ(report.planes[0].cells_textured, 0);
+  for (double bar : {PlaneGrowthOptions().min_parallax_deg, 80.0}) {
+    options.min_parallax_deg = bar;
+    std::vector<PlaneSegment> segments = {FrontWallPatch(textured, 0.0)};
+    const PlaneGrowthReport report =
+        GrowPlanePolygons(options, textured.camera, textured.world_from_cam, {},
+                          {}, Loader(textured), &segments);
+    if (bar == 80.0) {
+      EXPECT_EQ(report.planes[0].cells_textured, 0);
+    } else {
+      EXPECT_GT(report.planes[0].cells_textured, 10);
+    }
+  }
 }
 
 // Auto-exposure brightens and darkens whole frames. Flat grey frames
