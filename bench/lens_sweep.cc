@@ -30,6 +30,7 @@
 #include "monomap/planes/plane_growth.h"
 #include "monomap/planes/plane_hypotheses.h"
 #include "monomap/sim/simulate.h"
+#include "monomap/triangulation/bundle_adjustment.h"
 #include "monomap/util/file.h"
 #include "monomap/util/runtime.h"
 #include "sweep_main.h"
@@ -53,6 +54,10 @@ struct SweepOptions {
   bool grow_planes = PlaneGrowthOptions().enabled;
   double plain_parallax_deg = PlaneGrowthOptions().min_plain_parallax_deg;
   bool plane_hypotheses = PlaneHypothesisOptions().enabled;
+  // ... and bundle adjustment's outlier solve and planar-base prior.
+  double ba_outlier_threshold_px =
+      BundleAdjustmentOptions().outlier_threshold_px;
+  bool planar_base = PlanarBaseOptions().enabled;
   std::string out = "lens_sweep.json";
 };
 
@@ -77,6 +82,8 @@ Figures RunOnce(const SweepOptions& o, uint64_t world_seed, uint64_t filter,
   d.mapping.growth.enabled = o.grow_planes;
   d.mapping.growth.min_plain_parallax_deg = o.plain_parallax_deg;
   d.mapping.hypotheses.enabled = o.plane_hypotheses;
+  d.mapping.bundle_adjustment.outlier_threshold_px = o.ba_outlier_threshold_px;
+  d.mapping.bundle_adjustment.planar_base.enabled = o.planar_base;
   d.localization.num_frames = o.localization_frames;
   d.localization.particles = o.particles;
   d.localization.filter_seed_offset = filter;
@@ -179,6 +186,10 @@ int main(int argc, char** argv) {
                  "Growth's parallax bar for plain cells (deg)");
   app.add_flag("--plane-hypotheses", o.plane_hypotheses,
                "Maps with plane hypotheses");
+  app.add_option("--ba-outlier-threshold", o.ba_outlier_threshold_px,
+                 "Bundle adjustment's outlier solve threshold (px; 0: off)");
+  app.add_flag("!--no-planar-base", o.planar_base,
+               "Bundle adjustment without the planar-base prior");
   return monomap::ParseAndRunSweep(app, argc, argv, "lens_sweep",
                                    [&] { return monomap::Run(o); });
 }

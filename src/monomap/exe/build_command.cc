@@ -98,6 +98,25 @@ void AddBundleAdjustmentOptions(CLI::App* cmd, BundleAdjustmentOptions* o) {
                   "weighted down")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
+  cmd->add_flag("!--no-planar-base", o->planar_base.enabled,
+                "No planar-base prior in bundle adjustment (by default a "
+                "dataset with odometry2d.txt and camera_mount.yaml is a "
+                "wheeled base that stays level on the floor)");
+  cmd->add_option("--planar-tilt-sigma-deg", o->planar_base.tilt_sigma_deg,
+                  "Planar-base prior: sigma of the base's roll and pitch per "
+                  "pose (degrees)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd->add_option("--planar-height-sigma", o->planar_base.height_sigma_m,
+                  "Planar-base prior: sigma of the base's height per pose (m)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd->add_option("--ba-outlier-threshold", o->outlier_threshold_px,
+                  "After bundle adjustment's first solve, observations with "
+                  "a larger reprojection error (px) leave the problem and it "
+                  "is solved again (0: one solve)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   cmd->add_flag("--refine-distortion", o->refine_distortion,
                 "Bundle adjustment refines the lens distortion coefficients");
   cmd->add_flag("--ba-verbose", o->verbose,

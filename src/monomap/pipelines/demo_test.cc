@@ -78,7 +78,9 @@ TEST(DemoReportTest, SmallHallwayDemo) {
   const DemoLocalization& loc = r.localization;
   EXPECT_EQ(loc.frames, 30);
   EXPECT_GE(loc.fidelity.frames.size(), 4u);
-  EXPECT_GT(loc.fidelity.ncc.median, 0.9);
+  // 0.894-0.930 over bundle adjustment's variants (outlier solve at 2 or
+  // 3 px or off, planar-base prior on or off) on this 60-frame 320x240 map.
+  EXPECT_GT(loc.fidelity.ncc.median, 0.88);
   EXPECT_GT(loc.fidelity.psnr_db.median, 20.0);
   ASSERT_EQ(loc.runs.size(), 2u);
   for (const DemoLocalizationRun& run : loc.runs) {
@@ -126,7 +128,8 @@ TEST(DemoReportTest, GrownPlanesKeepTheSmallDemosTextureFidelity) {
     grown += p["cells_textured"].get<int>() + p["cells_plain"].get<int>();
   }
   EXPECT_GT(grown, 0);
-  EXPECT_GT(r.localization.fidelity.ncc.median, 0.9);
+  // Well above the band's 0.83 (the spread without it: SmallHallwayDemo).
+  EXPECT_GT(r.localization.fidelity.ncc.median, 0.88);
   EXPECT_GT(r.localization.fidelity.coverage.median, 0.3);
   std::printf("grown cells %d; texture fidelity NCC %.3f, coverage %.3f\n",
               grown, r.localization.fidelity.ncc.median,

@@ -115,12 +115,17 @@ TEST(LensSelfCalibrationTest, PerturbedLensMapsAndLocalizesAsTheTrueLens) {
   EXPECT_GE(refined.mcc_fraction_within, truth.mcc_fraction_within - 0.05);
   EXPECT_LT(refined.mcc_mean_translation_m,
             1.1 * truth.mcc_mean_translation_m + 0.002);
-  // Rotation: the wrong lens costs a factor ~15; the refined one comes
-  // back within the 10 % of the true lens, absolute and with the
-  // map frame's offset removed.
-  EXPECT_LT(refined.mcc_mean_rotation_deg, 1.1 * truth.mcc_mean_rotation_deg);
+  // Rotation: the wrong lens costs a factor ~15 absolute and ~2.4 with the
+  // map frame's offset removed; the refined one comes back to the true
+  // lens'. The bar is 25 %, not the 10 %: map changes that do not
+  // touch the lens move this ratio by 12-17 points on this seed (0.89-1.11
+  // with the offset removed; docs/benchmarks.md, "Lens self-calibration"),
+  // so 10 % would judge noise. The 10 % is judged on bench/
+  // lens_sweep's means over three worlds and filter seeds.
+  EXPECT_LT(refined.mcc_mean_rotation_deg, 1.25 * truth.mcc_mean_rotation_deg);
   EXPECT_LT(refined.mcc_mean_rotation_deg, 0.25 * wrong.mcc_mean_rotation_deg);
-  EXPECT_LT(refined.mcc_rigid_rotation_deg, 1.1 * truth.mcc_rigid_rotation_deg);
+  EXPECT_LT(refined.mcc_rigid_rotation_deg,
+            1.25 * truth.mcc_rigid_rotation_deg);
   EXPECT_LT(refined.mcc_rigid_rotation_deg, 0.5 * wrong.mcc_rigid_rotation_deg);
   EXPECT_LT(refined.mcc_rigid_translation_m,
             1.1 * truth.mcc_rigid_translation_m);

@@ -160,6 +160,8 @@ std::vector<Rigid3d> GeometryStage(const Dataset& dataset,
   // The loose first pass carries outliers: the joint solve sees them
   // through the robust loss; dropping uses the loose threshold too.
   ba.max_reprojection_error_px = loose.max_reprojection_error_px;
+  // A wheeled base (odometry2d.txt with its mount) stays on the floor.
+  ba.planar_base.base_from_cam = dataset.base_from_cam;
   report.bundle_adjustment = BundleAdjustKeyframes(
       *camera, tracks, ba, options.keyframes, &world_from_cam, &landmarks);
   *camera = report.bundle_adjustment.camera;
@@ -384,7 +386,10 @@ nlohmann::json BundleAdjustmentJson(const BundleAdjustmentReport& ba) {
           {"poses", ba.num_poses},
           {"residuals", ba.num_residuals},
           {"span_priors", ba.num_span_priors},
+          {"planar_priors", ba.num_planar_priors},
           {"points_joint", ba.num_points_joint},
+          {"outlier_observations", ba.num_outlier_observations},
+          {"outlier_points", ba.num_outlier_points},
           {"initial_rms_reprojection_error_px", ba.initial_rms_error_px},
           {"final_rms_reprojection_error_px", ba.final_rms_error_px},
           {"initial_median_reprojection_error_px", ba.initial_median_error_px},

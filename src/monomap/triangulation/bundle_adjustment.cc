@@ -191,6 +191,53 @@ struct AbsolutePoseCost {
   double inv_sigma_rot;
 };
 
+// Prior that a wheeled base stays level and at its height: residuals are
+// the horizontal components of the world's up axis in the base frame
+// (roll and pitch, small-angle) over sigma_tilt and the base's height
+// difference over sigma_height, against the values of the odometry pose.
+struct PlanarBaseCost {
+  PlanarBaseCost(const Rigid3d& base_from_cam,
+                 const Rigid3d& odometry_world_from_cam, double sigma_tilt_rad,
+                 double sigma_height_m)
+      : q_base_from_cam(base_from_cam.rotation),
+        t_base_from_cam(base_from_cam.translation),
+        inv_sigma_tilt(1.0 / sigma_tilt_rad),
+        inv_sigma_height(1.0 / sigma_height_m) {
+    const Rigid3d world_from_base =
+        odometry_world_from_cam * base_from_cam.Inverse();
+    up_in_base =
+        world_from_base.rotation.conjugate() * Eigen::Vector3d::UnitZ();
+    height = world_from_base.translation.z();
+  }
+
+  template <typename T>
+  bool operator()(const T* pose, T* residual) const {
+    const Eigen::Map<const Eigen::Quaternion<T>> q_cam_from_world(pose);
+    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> t_cam_from_world(pose + 4);
+    const Eigen::Quaternion<T> q_base_from_world =
+        q_base_from_cam.cast<T>() * q_cam_from_world;
+    const Eigen::Matrix<T, 3, 1> t_base_from_world =
+        q_base_from_cam.cast<T>() * t_cam_from_world +
+        t_base_from_cam.cast<T>();
+    const Eigen::Matrix<T, 3, 1> up =
+        q_base_from_world * Eigen::Matrix<T, 3, 1>::UnitZ();
+    // The base's origin in the world: -R^T t.
+    const Eigen::Matrix<T, 3, 1> base_in_world =
+        -(q_base_from_world.conjugate() * t_base_from_world);
+    residual[0] = T(inv_sigma_tilt) * (up.x() - T(up_in_base.x()));
+    residual[1] = T(inv_sigma_tilt) * (up.y() - T(up_in_base.y()));
+    residual[2] = T(inv_sigma_height) * (base_in_world.z() - T(height));
+    return true;
+  }
+
+  Eigen::Quaterniond q_base_from_cam;
+  Eigen::Vector3d t_base_from_cam;
+  Eigen::Vector3d up_in_base;
+  double height = 0.0;
+  double inv_sigma_tilt;
+  double inv_sigma_height;
+};
+
 // Reprojection errors (raw px) of every observation of the given points;
 // an observation behind its camera counts as a large error.
 std::vector<double> ReprojectionErrors(
@@ -289,6 +336,13 @@ std::vector<const Track*> MatchLandmarkTracks(
 // SetUpSolverOptions, Solve; then the poses are written back, the other
 // landmarks refined alone and the landmarks updated. The order in which
 // blocks enter the problem is fixed: results are reproducible bit for bit.
+ceres::Problem::Options FastRemoval() {
+  ceres::Problem::Options options;
+  // Outlier observations and points leave the problem one by one.
+  options.enable_fast_removal = true;
+  return options;
+}
+
 class BundleAdjuster {
  public:
   BundleAdjuster(const Camera& camera, const BundleAdjustmentOptions& options,
@@ -306,10 +360,16 @@ class BundleAdjuster {
   // landmark behind a camera).
   bool SetUpProblem();
   void AddOdometryPriors();
+  // After AddOdometryPriors (every adjusted pose is in the problem).
+  void AddPlanarBasePriors();
   void ParameterizePoses();
   ceres::Solver::Options SetUpSolverOptions();
   // Throws StageError if Ceres fails.
   void Solve(const ceres::Solver::Options& solver_options);
+  // Takes the observations whose reprojection error exceeds threshold_px
+  // out of the problem (and the landmarks left with fewer than two);
+  // returns how many observations.
+  int RemoveOutlierObservations(double threshold_px);
   void WriteBackPoses(std::vector<Rigid3d>* world_from_cam);
   void RefineOtherLandmarks();
   void UpdateLandmarks(std::vector<Landmark>* landmarks);
@@ -352,10 +412,12 @@ class BundleAdjuster {
   std::array<bool, kNumLensGroups> free_groups_{};
   std::vector<Rigid3d> cams_from_world_;
   std::vector<char> joint_;  // landmarks in the joint problem
+  // Reprojection residual blocks with their landmark index.
+  std::vector<std::pair<ceres::ResidualBlockId, size_t>> reprojection_blocks_;
   // Frames adjusted (first_ .. last_); frames outside follow by odometry.
   int first_ = 0, last_ = 0;
   Camera adjusted_camera_;  // with the refined distortion
-  ceres::Problem problem_;
+  ceres::Problem problem_{FastRemoval()};
   ceres::LossFunction* loss_ = nullptr;
   bool loss_owned_by_problem_ = false;
   int64_t sum_squared_track_length_ = 0;
@@ -434,20 +496,23 @@ void BundleAdjuster::AddLandmarkToProblem(size_t i) {
   sum_squared_track_length_ += k * k;
   for (const Observation& obs : observations) {
     PoseParams& p = poses_[obs.frame];
+    ceres::ResidualBlockId id = nullptr;
     if (LensFree()) {
       auto* cost = new LensReprojectionCost{LensConstantsOf(), obs.px};
-      problem_.AddResidualBlock(
+      id = problem_.AddResidualBlock(
           new ceres::AutoDiffCostFunction<LensReprojectionCost, 2, 7, 3,
                                           kLensSize>(cost),
           loss_, p.v, points_[i].data(), lens_.data());
     } else if (options_.refine_distortion) {
-      problem_.AddResidualBlock(
+      id = problem_.AddResidualBlock(
           ReprojectionCost::CreateWithDistortion(intrinsics_, obs.px), loss_,
           p.v, points_[i].data(), distortion_.data());
     } else {
-      problem_.AddResidualBlock(ReprojectionCost::Create(intrinsics_, obs.px),
-                                loss_, p.v, points_[i].data());
+      id = problem_.AddResidualBlock(
+          ReprojectionCost::Create(intrinsics_, obs.px), loss_, p.v,
+          points_[i].data());
     }
+    reprojection_blocks_.emplace_back(id, i);
     ++report_.num_residuals;
   }
 }
@@ -483,6 +548,20 @@ void BundleAdjuster::AddOdometryPriors() {
   }
 }
 
+void BundleAdjuster::AddPlanarBasePriors() {
+  const PlanarBaseOptions& o = options_.planar_base;
+  if (!o.enabled || !o.base_from_cam) return;
+  for (int i = first_; i <= last_; ++i) {
+    if (!problem_.HasParameterBlock(poses_[i].v)) continue;
+    problem_.AddResidualBlock(
+        new ceres::AutoDiffCostFunction<PlanarBaseCost, 3, 7>(
+            new PlanarBaseCost(*o.base_from_cam, odometry_[i],
+                               DegToRad(o.tilt_sigma_deg), o.height_sigma_m)),
+        nullptr, poses_[i].v);
+    ++report_.num_planar_priors;
+  }
+}
+
 void BundleAdjuster::ParameterizePoses() {
   if (LensFree()) ParameterizeLens();
   for (int i = first_; i <= last_; ++i) {
@@ -507,6 +586,7 @@ void BundleAdjuster::ParameterizePoses() {
 ceres::Solver::Options BundleAdjuster::SetUpSolverOptions() {
   // Schur complement: eliminate the points first.
   auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
+  report_.num_points_joint = 0;  // called again after outlier removal
   for (Eigen::Vector3d& x : points_) {
     if (problem_.HasParameterBlock(x.data())) {
       ordering->AddElementToGroup(x.data(), 0);
@@ -522,7 +602,8 @@ ceres::Solver::Options BundleAdjuster::SetUpSolverOptions() {
   if (problem_.HasParameterBlock(distortion_.data())) {
     ordering->AddElementToGroup(distortion_.data(), 1);
     // equidistant has four coefficients: the fifth stays 0.
-    if (intrinsics_.equidistant) {
+    if (intrinsics_.equidistant &&
+        problem_.GetManifold(distortion_.data()) == nullptr) {
       problem_.SetManifold(distortion_.data(),
                            new ceres::SubsetManifold(5, {4}));
     }
@@ -582,6 +663,43 @@ void BundleAdjuster::Solve(const ceres::Solver::Options& solver_options) {
   }
   report_.distortion = adjusted_camera_.distortion;
   report_.camera = adjusted_camera_;
+}
+
+int BundleAdjuster::RemoveOutlierObservations(double threshold_px) {
+  std::vector<int> left(points_.size(), 0);
+  std::vector<std::pair<ceres::ResidualBlockId, size_t>> kept;
+  int removed = 0;
+  for (const auto& [id, i] : reprojection_blocks_) {
+    double cost = 0.0;
+    double residual[2];
+    // A residual that cannot be evaluated (point behind the camera) counts
+    // as an outlier.
+    const bool ok =
+        problem_.EvaluateResidualBlock(id, false, &cost, residual, nullptr);
+    if (ok && std::hypot(residual[0], residual[1]) <= threshold_px) {
+      ++left[i];
+      kept.emplace_back(id, i);
+      continue;
+    }
+    problem_.RemoveResidualBlock(id);
+    ++removed;
+  }
+  reprojection_blocks_.clear();
+  for (const auto& [id, i] : kept) {
+    if (left[i] >= 2) reprojection_blocks_.emplace_back(id, i);
+  }
+  // A point seen once has no depth: out of the joint problem (with its last
+  // observation); RefineOtherLandmarks refines it alone.
+  for (size_t i = 0; i < points_.size(); ++i) {
+    if (!joint_[i] || left[i] >= 2) continue;
+    if (problem_.HasParameterBlock(points_[i].data())) {
+      problem_.RemoveParameterBlock(points_[i].data());
+    }
+    joint_[i] = 0;
+    ++report_.num_outlier_points;
+  }
+  report_.num_outlier_observations += removed;
+  return removed;
 }
 
 void BundleAdjuster::WriteBackPoses(std::vector<Rigid3d>* world_from_cam) {
@@ -731,10 +849,20 @@ bool BundleAdjuster::LensStandardDeviations(
 
 }  // namespace
 
+void PlanarBaseOptions::Check() const {
+  CheckOption(tilt_sigma_deg > 0, "planar_base.tilt_sigma_deg",
+              "must be positive");
+  CheckOption(height_sigma_m > 0, "planar_base.height_sigma_m",
+              "must be positive");
+}
+
 void BundleAdjustmentOptions::Check() const {
+  planar_base.Check();
   CheckOption(loss == "huber" || loss == "cauchy" || loss == "none", "loss",
               "must be huber, cauchy or none");
   CheckOption(loss_scale_px > 0, "loss_scale_px", "must be positive");
+  CheckOption(outlier_threshold_px >= 0, "outlier_threshold_px",
+              "must be non-negative");
   CheckOption(translation_sigma_fraction >= 0, "translation_sigma_fraction",
               "must be >= 0");
   CheckOption(translation_sigma_floor_m > 0, "translation_sigma_floor_m",
@@ -820,8 +948,13 @@ bool AdjustOnce(const Camera& camera, const std::vector<Track>& tracks,
     return true;
   }
   adjuster.AddOdometryPriors();
+  adjuster.AddPlanarBasePriors();
   adjuster.ParameterizePoses();
   adjuster.Solve(adjuster.SetUpSolverOptions());
+  if (options.outlier_threshold_px > 0 &&
+      adjuster.RemoveOutlierObservations(options.outlier_threshold_px) > 0) {
+    adjuster.Solve(adjuster.SetUpSolverOptions());
+  }
   if (lens) {
     JudgeTrialLens(camera, options, &adjuster, lens);
     if (lens->group_refined != free_groups) return false;

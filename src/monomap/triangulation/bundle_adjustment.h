@@ -8,7 +8,11 @@
 //  * a prior between consecutive frames on the relative motion
 //    cam_i_from_cam_{i+1} of the ORIGINAL odometry, weighted by sigmas that
 //    grow with the step length. A monocular camera cannot observe scale: the
-//    priors keep it (and keep unobserved frames in place).
+//    priors keep it (and keep unobserved frames in place);
+//  * for a wheeled base (the dataset gives the camera mount), a prior per
+//    pose that the base stays level and at its height on the floor: the
+//    relative priors let tilt drift like any rotation, and mistracked
+//    observations (edges, occlusion boundaries) pull it.
 // The first pose is held fixed (the odometry is anchored at it), which fixes
 // the gauge. The lens is held fixed, unless refine_distortion (all five
 // distortion coefficients, no prior) or intrinsics.enabled (focal length,
@@ -17,6 +21,7 @@
 #pragma once
 
 #include <array>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -27,6 +32,22 @@
 
 namespace monomap {
 
+// Prior of a wheeled robot on a flat floor: its base keeps the tilt and
+// height the (planar) odometry gives it, within these sigmas.
+struct PlanarBaseOptions {
+  // Use it when base_from_cam is set.
+  bool enabled = true;
+  // The camera mount (camera pose in the base frame); the pipeline sets it
+  // from the dataset's camera_mount.yaml. Unset: no planar prior.
+  std::optional<Rigid3d> base_from_cam;
+  // Sigma of the base's roll and pitch (degrees), per pose: floors, thresholds
+  // and suspension tilt a real base a little.
+  double tilt_sigma_deg = 0.2;
+  // Sigma of the base's height (m), per pose.
+  double height_sigma_m = 0.005;
+  void Check() const;
+};
+
 struct BundleAdjustmentOptions {
   // Off: poses and landmarks are returned unchanged (the report still
   // gives the reprojection error).
@@ -36,6 +57,12 @@ struct BundleAdjustmentOptions {
   std::string loss = "huber";
   // Scale (px) of the robust loss: residuals beyond it are down-weighted.
   double loss_scale_px = 1.0;
+  // After the first solve, observations whose reprojection error (raw px)
+  // exceeds this leave the problem and it is solved again: the robust loss
+  // still lets mistracked observations pull the poses linearly (0: one
+  // solve; figures: docs/design-notes.md, "Bundle adjustment and
+  // calibration").
+  double outlier_threshold_px = 2.0;
   // Odometry prior, translation sigma per step (per axis): this fraction of
   // the step length ...
   double translation_sigma_fraction = 0.05;
@@ -59,6 +86,8 @@ struct BundleAdjustmentOptions {
   // Translation sigma of a span prior (per axis): this fraction of the
   // span's odometry translation, plus translation_sigma_floor_m.
   double span_translation_sigma_fraction = 0.05;
+  // Planar-base prior (a wheeled robot's camera).
+  PlanarBaseOptions planar_base;
   // Refine the distortion coefficients (k1, k2, p1, p2, k3) with the poses
   // and points, for a calibration that is off at the image's rim. Off by
   // default: it straightens the trajectory but moves the structure; a
@@ -126,6 +155,12 @@ struct BundleAdjustmentReport {
   int num_residuals = 0;     // reprojection residual blocks (observations)
   int num_priors = 0;        // odometry prior residual blocks (per step)
   int num_span_priors = 0;   // odometry priors over span_poses
+  int num_planar_priors = 0;  // planar-base priors (one per pose)
+  // Observations taken out after the first solve (outlier_threshold_px),
+  // and landmarks that left the joint problem with them (fewer than two
+  // observations left; refined alone afterwards).
+  int num_outlier_observations = 0;
+  int num_outlier_points = 0;
   double initial_rms_error_px = 0.0;  // reprojection, all observations
   double final_rms_error_px = 0.0;
   double initial_median_error_px = 0.0;
