@@ -28,6 +28,9 @@ if [[ $# -gt 0 && $1 != -- ]]; then DATA=$1; shift; fi
 BUILD_ARGS=("$@")
 FRAMES=${FRAMES:-100}
 SIM_DIR=${SIM_DIR:-}
+# SIM_ARGS: more `monomap simulate` options for every world (e.g.
+# "--floor-tilt 0.3" for an uneven floor); use another SIM_DIR with them.
+read -r -a SIM_ARGS <<<"${SIM_ARGS:-}"
 [[ -x $BIN ]] || { echo "$BIN: not an executable" >&2; exit 2; }
 mkdir -p "$OUT"
 OUT=$(realpath "$OUT")
@@ -54,7 +57,7 @@ for c in "${SIM_CASES[@]}"; do
     rm -rf "$d"
     "$BIN" simulate "$world" --seed "$seed" --camera-height "$h" \
       --camera-tilt "$p" --fps "$fps" --speed "$speed" --frames "$FRAMES" \
-      -q -o "$d"
+      "${SIM_ARGS[@]}" -q -o "$d"
     touch "$d/.done"
   fi
   rm -rf "$OUT/map_$name"

@@ -50,6 +50,11 @@ void AddCameraOptions(CLI::App* cmd, SimulationOptions* o) {
   cmd->add_option("--camera-tilt", o->mount.tilt_down_deg,
                   "Downward pitch of the camera (degrees)")
       ->capture_default_str();
+  cmd->add_option("--floor-tilt", o->floor_tilt_deg,
+                  "Uneven floor: the base rolls and pitches by up to about "
+                  "this much (degrees), unseen by the planar odometry")
+      ->check(CLI::Range(0.0, 10.0))
+      ->capture_default_str();
   cmd->add_option("--focal", o->focal_px_at_640,
                   "Focal length (pixels, for a 640-pixel-wide image)")
       ->capture_default_str();

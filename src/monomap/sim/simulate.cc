@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <opencv2/imgcodecs.hpp>
+#include <random>
 #include <sstream>
 
 #include "monomap/io/dataset.h"
@@ -37,6 +38,8 @@ void SimulationOptions::Check() const {
       "sim.texture_pixels_per_meter", "must be in [20, 2000]");
   path.Check();
   mount.Check();
+  CheckOption(floor_tilt_deg >= 0 && floor_tilt_deg <= 10, "sim.floor_tilt_deg",
+              "must be in [0, 10]");
   odometry.Check();
   render.Check();
   effects.Check();
@@ -90,6 +93,37 @@ std::vector<TimedPose> CameraPoses(const std::vector<TimedPose2d>& base,
   out.reserve(base.size());
   for (const TimedPose2d& p : base) {
     out.push_back({p.timestamp, WorldFromCamOfBase(p.pose, base_from_cam)});
+  }
+  return out;
+}
+
+// The true camera poses on an uneven floor: the base rolls and pitches
+// about its origin by smooth functions of the distance driven.
+std::vector<TimedPose> TiltedCameraPoses(const std::vector<TimedPose2d>& base,
+                                         const Rigid3d& base_from_cam,
+                                         double amplitude_deg, uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> phase(0.0, 2.0 * M_PI);
+  const double roll_phase[2] = {phase(rng), phase(rng)};
+  const double pitch_phase[2] = {phase(rng), phase(rng)};
+  auto wave = [&](const double* ph, double s) {
+    return DegToRad(amplitude_deg) *
+           (0.6 * std::sin(2.0 * M_PI * s / 1.3 + ph[0]) +
+            0.4 * std::sin(2.0 * M_PI * s / 0.45 + ph[1]));
+  };
+  std::vector<TimedPose> out;
+  double s = 0.0;
+  for (size_t i = 0; i < base.size(); ++i) {
+    const Pose2d& p = base[i].pose;
+    if (i > 0) {
+      s += std::hypot(p.x - base[i - 1].pose.x, p.y - base[i - 1].pose.y);
+    }
+    const Eigen::Quaterniond tilt = QuaternionFromRotationVector(
+        Eigen::Vector3d(wave(roll_phase, s), wave(pitch_phase, s), 0));
+    const Rigid3d world_from_base = WorldFromCamOfBase(p, Rigid3d());
+    out.push_back({base[i].timestamp,
+                   world_from_base * Rigid3d(tilt, Eigen::Vector3d::Zero()) *
+                       base_from_cam});
   }
   return out;
 }
@@ -254,7 +288,11 @@ SimulationReport Simulate(const SimulationOptions& options,
   const std::vector<TimedPose2d> odom =
       SimulateOdometry(truth, options.odometry, run_seed);
   const Rigid3d base_from_cam = MakeCameraMount(options.mount);
-  const std::vector<TimedPose> gt_cam = CameraPoses(truth, base_from_cam);
+  const std::vector<TimedPose> gt_cam =
+      options.floor_tilt_deg > 0
+          ? TiltedCameraPoses(truth, base_from_cam, options.floor_tilt_deg,
+                              SimMixSeed(run_seed, 2000000))
+          : CameraPoses(truth, base_from_cam);
   const std::vector<TimedPose> odom_cam = CameraPoses(odom, base_from_cam);
   FillPathReport(world, truth, odom, &report);
   const int n = report.frames;

@@ -44,6 +44,11 @@ struct SimulationOptions {
   // odometry errors.
   RobotPathOptions path;
   CameraMountOptions mount;
+  // Uneven floor: the base rolls and pitches smoothly along the path, each
+  // by up to about this much (degrees; two sinusoids over the distance
+  // driven, 1.3 and 0.45 m long, phases from run_seed). The planar
+  // odometry does not see it; 0: a flat floor.
+  double floor_tilt_deg = 0.0;
   OdometryNoiseOptions odometry;
   // Rendering and camera effects.
   RenderOptions render;

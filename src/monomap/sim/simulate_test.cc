@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <map>
@@ -210,6 +211,44 @@ TEST(SimulateTest, DriftIsReportedAndZeroWithoutNoise) {
     EXPECT_LT((f.odometry_world_from_cam.translation -
                f.groundtruth_world_from_cam->translation).norm(), 1e-6);
   }
+  fs::remove_all(dir);
+}
+
+// Base tilt (degrees) of a camera pose: the angle between the base's up
+// axis and the world's.
+double BaseTiltDeg(const Rigid3d& world_from_cam,
+                   const Rigid3d& base_from_cam) {
+  const Rigid3d world_from_base = world_from_cam * base_from_cam.Inverse();
+  const Eigen::Vector3d up =
+      world_from_base.rotation * Eigen::Vector3d::UnitZ();
+  return std::acos(std::min(1.0, up.z())) * 180.0 / M_PI;
+}
+
+TEST(SimulateTest, UnevenFloorTiltsTheTruthNotTheOdometry) {
+  const fs::path dir = TempDir("tilt");
+  SimulationOptions o = SmallOptions();
+  o.num_frames = 60;
+  o.floor_tilt_deg = 0.5;
+  Simulate(o, dir);
+  const Dataset ds = LoadDataset(dir);
+  ASSERT_TRUE(ds.base_from_cam.has_value());
+  double max_true = 0.0, max_odometry = 0.0, max_height = 0.0;
+  for (const DatasetFrame& f : ds.frames) {
+    max_true = std::max(max_true, BaseTiltDeg(*f.groundtruth_world_from_cam,
+                                              *ds.base_from_cam));
+    max_odometry = std::max(max_odometry, BaseTiltDeg(f.odometry_world_from_cam,
+                                                      *ds.base_from_cam));
+    const Rigid3d base =
+        *f.groundtruth_world_from_cam * ds.base_from_cam->Inverse();
+    max_height = std::max(max_height, std::abs(base.translation.z()));
+  }
+  // Two sinusoids of 0.6 and 0.4 x 0.5 deg per axis: at most ~0.7 deg.
+  EXPECT_GT(max_true, 0.1);
+  EXPECT_LT(max_true, 0.75);
+  EXPECT_LT(max_odometry, 1e-6);
+  EXPECT_LT(max_height, 1e-9);  // tilted about the base's origin
+  o.floor_tilt_deg = -1.0;
+  EXPECT_THROW(o.Check(), OptionsError);
   fs::remove_all(dir);
 }
 
