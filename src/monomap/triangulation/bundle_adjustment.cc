@@ -330,12 +330,6 @@ std::vector<const Track*> MatchLandmarkTracks(
   return landmark_tracks;
 }
 
-// One adjustment, in the steps of a classic bundle adjuster: SetUpProblem
-// (reprojection residuals of the joint landmarks, AddLandmarkToProblem),
-// AddOdometryPriors, ParameterizePoses (manifolds, gauge),
-// SetUpSolverOptions, Solve; then the poses are written back, the other
-// landmarks refined alone and the landmarks updated. The order in which
-// blocks enter the problem is fixed: results are reproducible bit for bit.
 ceres::Problem::Options FastRemoval() {
   ceres::Problem::Options options;
   // Outlier observations and points leave the problem one by one.
@@ -343,6 +337,13 @@ ceres::Problem::Options FastRemoval() {
   return options;
 }
 
+// One adjustment, in the steps of a classic bundle adjuster: SetUpProblem
+// (reprojection residuals of the joint landmarks, AddLandmarkToProblem),
+// AddOdometryPriors, AddPlanarBasePriors, ParameterizePoses (manifolds,
+// gauge), SetUpSolverOptions, Solve (and, after RemoveOutlierObservations,
+// Solve again); then the poses are written back, the other
+// landmarks refined alone and the landmarks updated. The order in which
+// blocks enter the problem is fixed: results are reproducible bit for bit.
 class BundleAdjuster {
  public:
   BundleAdjuster(const Camera& camera, const BundleAdjustmentOptions& options,
