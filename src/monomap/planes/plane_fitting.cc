@@ -132,7 +132,7 @@ namespace {
 class Grid2d {
  public:
   Grid2d(const std::vector<Eigen::Vector2d>& points, double cell)
-      : points_(points), inv_cell_(1.0 / cell) {
+      : inv_cell_(1.0 / cell) {
     for (size_t i = 0; i < points.size(); ++i) {
       const auto [cx, cy] = CellOf(points[i]);
       cells_[Key(cx, cy)].push_back(static_cast<int>(i));
@@ -159,7 +159,6 @@ class Grid2d {
   static int64_t Key(int64_t x, int64_t y) {
     return (x << 32) ^ (y & 0xffffffffLL);
   }
-  const std::vector<Eigen::Vector2d>& points_;
   double inv_cell_;
   std::unordered_map<int64_t, std::vector<int>> cells_;
 };
