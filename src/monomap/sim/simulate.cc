@@ -120,10 +120,10 @@ std::vector<TimedPose> TiltedCameraPoses(const std::vector<TimedPose2d>& base,
     }
     const Eigen::Quaterniond tilt = QuaternionFromRotationVector(
         Eigen::Vector3d(wave(roll_phase, s), wave(pitch_phase, s), 0));
-    const Rigid3d world_from_base = WorldFromCamOfBase(p, Rigid3d());
-    out.push_back({base[i].timestamp,
-                   world_from_base * Rigid3d(tilt, Eigen::Vector3d::Zero()) *
-                       base_from_cam});
+    out.push_back(
+        {base[i].timestamp,
+         WorldFromCamOfBase(
+             p, Rigid3d(tilt, Eigen::Vector3d::Zero()) * base_from_cam)});
   }
   return out;
 }
