@@ -690,12 +690,14 @@ int BundleAdjuster::RemoveOutlierObservations(double threshold_px) {
     if (left[i] >= 2) reprojection_blocks_.emplace_back(id, i);
   }
   // A point seen once has no depth: out of the joint problem (with its last
-  // observation); RefineOtherLandmarks refines it alone.
+  // observation); RefineOtherLandmarks refines it alone. (Points that never
+  // entered the problem, behind a camera, stay as they were.)
   for (size_t i = 0; i < points_.size(); ++i) {
-    if (!joint_[i] || left[i] >= 2) continue;
-    if (problem_.HasParameterBlock(points_[i].data())) {
-      problem_.RemoveParameterBlock(points_[i].data());
+    if (!joint_[i] || left[i] >= 2 ||
+        !problem_.HasParameterBlock(points_[i].data())) {
+      continue;
     }
+    problem_.RemoveParameterBlock(points_[i].data());
     joint_[i] = 0;
     ++report_.num_outlier_points;
   }
