@@ -36,9 +36,10 @@ echo "odometry, frames 151-300: vs ground truth $(medians "$OUT/odometry_151.txt
 
 SPAN="--odometry-rotation-sigma-deg 0.1 --odometry-span 10"
 LENS="--camera $OUT/cal_f1.yaml"
-# The refitted lens' maps leave bundle adjustment's outlier solve out: with
-# this lens it costs orientation (docs/benchmarks.md, "Desk localization").
-BUILD_LENS="$LENS --ba-outlier-threshold 0"
+# The refitted lens' maps leave bundle adjustment's outlier solve and the
+# tracker's track splitting out: with this lens each costs orientation
+# (docs/benchmarks.md, "Desk localization").
+BUILD_LENS="$LENS --ba-outlier-threshold 0 --no-split-tracks"
 # The estimate's refinement pays only with the refitted lens (MccCorrection-
 # Options::refine_estimate), so the refitted configurations turn it on.
 REFINE="--refine-width 1024"

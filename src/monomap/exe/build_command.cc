@@ -28,6 +28,8 @@ struct BuildArgs {
   // Negative flags, applied to `options` after parsing.
   bool no_bundle_adjustment = false;
   bool no_affine = false;
+  bool no_split_tracks = false;
+  double image_noise = -1.0;  // --image-noise; < 0: estimated
   bool no_merge_coplanar = false;
   bool no_see_through = false;
   bool no_grow_planes = false;
@@ -345,6 +347,13 @@ void AddMappingOptions(CLI::App* cmd, BuildArgs* a) {
   cmd->add_flag("--no-affine-refinement", a->no_affine,
                 "Track frame to frame only (no alignment with each "
                 "feature's reference patch)");
+  cmd->add_flag("--no-split-tracks", a->no_split_tracks,
+                "Let a feature keep its id when its alignment with its "
+                "reference patch fails (default: it goes on under a new id)");
+  cmd->add_option("--image-noise", a->image_noise,
+                  "The images' noise (grey levels) the alignment allows for "
+                  "(default: estimated from the first frame; 0: none)")
+      ->check(CLI::NonNegativeNumber);
   AddBundleAdjustmentOptions(cmd, &o.bundle_adjustment);
   AddLensOptions(cmd, &o.bundle_adjustment.intrinsics);
   AddPointTrustOptions(cmd, &o.point_trust, &o.inlier_refinement);
@@ -380,6 +389,11 @@ void RunBuild(const BuildArgs& a) {
   MappingOptions options = a.options;
   options.bundle_adjustment.enabled = !a.no_bundle_adjustment;
   options.tracking.affine_refinement = !a.no_affine;
+  options.tracking.split_on_failed_alignment = !a.no_split_tracks;
+  if (a.image_noise >= 0.0) {
+    options.tracking.estimate_noise = false;
+    options.tracking.affine.noise_sigma = a.image_noise;
+  }
   options.planes.merge_coplanar = !a.no_merge_coplanar;
   options.see_through.enabled = !a.no_see_through;
   options.growth.enabled = !a.no_grow_planes;

@@ -115,7 +115,7 @@ TEST(LensSelfCalibrationTest, PerturbedLensMapsAndLocalizesAsTheTrueLens) {
   EXPECT_GE(refined.mcc_fraction_within, truth.mcc_fraction_within - 0.05);
   EXPECT_LT(refined.mcc_mean_translation_m,
             1.1 * truth.mcc_mean_translation_m + 0.002);
-  // Rotation: the wrong lens costs a factor ~15 absolute and ~2.4 with the
+  // Rotation: the wrong lens costs a factor ~15 absolute and ~2 with the
   // map frame's offset removed; the refined one comes back to the true
   // lens'. The bar is 25 %, not the 10 %: map changes that do not
   // touch the lens move this ratio by 12-17 points on this seed (0.89-1.11
@@ -126,7 +126,11 @@ TEST(LensSelfCalibrationTest, PerturbedLensMapsAndLocalizesAsTheTrueLens) {
   EXPECT_LT(refined.mcc_mean_rotation_deg, 0.25 * wrong.mcc_mean_rotation_deg);
   EXPECT_LT(refined.mcc_rigid_rotation_deg,
             1.25 * truth.mcc_rigid_rotation_deg);
-  EXPECT_LT(refined.mcc_rigid_rotation_deg, 0.5 * wrong.mcc_rigid_rotation_deg);
+  // The wrong lens' rigid rotation is 2.0x the true lens' since the tracker
+  // splits failed tracks (2.4x before); the refined lens must stay well
+  // clear of it.
+  EXPECT_LT(refined.mcc_rigid_rotation_deg,
+            0.65 * wrong.mcc_rigid_rotation_deg);
   EXPECT_LT(refined.mcc_rigid_translation_m,
             1.1 * truth.mcc_rigid_translation_m);
 }

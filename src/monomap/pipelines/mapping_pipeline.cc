@@ -378,6 +378,8 @@ nlohmann::json TrackingJson(const TrackingReport& tracking) {
           {"mean_features_per_frame", tracking.mean_features_per_frame},
           {"affine_refined", tracking.refined},
           {"reference_patches_renewed", tracking.reanchored},
+          {"split_after_failed_alignment", tracking.split},
+          {"image_noise_sigma", tracking.noise_sigma},
           {"seconds", tracking.seconds}};
 }
 

@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <opencv2/imgproc.hpp>
+#include <vector>
 
 #include "monomap/util/error.h"
 #include "monomap/util/image_sampling.h"
@@ -21,6 +23,7 @@ void AffineRefinementOptions::Check() const {
               "must be in [-1, 1]");
   CheckOption(max_correction_px > 0, "affine.max_correction_px", "must be > 0");
   CheckOption(min_eigenvalue >= 0, "affine.min_eigenvalue", "must be >= 0");
+  CheckOption(noise_sigma >= 0, "affine.noise_sigma", "must be >= 0");
 }
 
 namespace {
@@ -48,6 +51,7 @@ bool FeatureTemplate::Extract(const cv::Mat& grey,
                               const AffineRefinementOptions& options) {
   values_.clear();
   jacobian_.clear();
+  variance_ = 0.0;
   const int w = options.window;
   const int r = w / 2;
   // One extra pixel around the window for the central differences.
@@ -111,6 +115,7 @@ bool FeatureTemplate::Extract(const cv::Mat& grey,
     jacobian_.clear();
     return false;
   }
+  variance_ = var;
   hessian_inverse_ = ldlt.solve(Eigen::Matrix<double, 6, 6>::Identity());
   return true;
 }
@@ -182,11 +187,11 @@ bool ComposeInverse(const Eigen::Matrix<double, 6, 1>& dp, Eigen::Matrix2f* a,
 // something else.
 bool LockedElsewhere(const Eigen::Matrix2f& a, const Eigen::Vector2f& t,
                      const Eigen::Vector2f& t0, bool converged, double ncc,
-                     const AffineRefinementOptions& options) {
+                     double min_ncc, const AffineRefinementOptions& options) {
   const Eigen::JacobiSVD<Eigen::Matrix2f> svd(a);
   const float s_max = svd.singularValues()(0), s_min = svd.singularValues()(1);
   return !converged || a.determinant() <= 0.0f || s_min < 0.5f ||
-         s_max > 2.0f || ncc < options.min_ncc ||
+         s_max > 2.0f || ncc < min_ncc ||
          (t - t0).norm() > options.max_correction_px;
 }
 
@@ -229,13 +234,38 @@ AffineRefinement FeatureTemplate::Refine(
   // epsilons of the feature point is as good as settled.
   const bool converged = last_step < 5.0f * options.epsilon_px;
   result.ncc = last_ncc;
-  if (LockedElsewhere(a, t, *t_io, converged, last_ncc, options)) {
+  // Both patches carry noise of variance sigma^2 against the reference's
+  // variance_ (which includes it): 2 - 2 NCC grows by 2 sigma^2 / variance_.
+  const double noise_cost =
+      options.noise_sigma * options.noise_sigma / variance_;
+  if (LockedElsewhere(a, t, *t_io, converged, last_ncc,
+                      options.min_ncc - noise_cost, options)) {
     return result;
   }
   result.accepted = true;
   *a_io = a;
   *t_io = t;
   return result;
+}
+
+double EstimateImageNoiseSigma(const cv::Mat& grey) {
+  if (grey.type() != CV_8UC1 || grey.rows < 3 || grey.cols < 3) {
+    throw InputError(
+        "noise estimation needs an 8-bit grey image of 3x3 or more");
+  }
+  // Second differences in both directions: zero on planes and ramps; on
+  // white noise of variance s^2 the response has variance 36 s^2.
+  const cv::Mat kernel =
+      (cv::Mat_<float>(3, 3) << 1, -2, 1, -2, 4, -2, 1, -2, 1);
+  cv::Mat response;
+  cv::filter2D(grey, response, CV_32F, kernel);
+  const cv::Mat inner =
+      cv::abs(response(cv::Rect(1, 1, grey.cols - 2, grey.rows - 2)));
+  std::vector<float> values(inner.begin<float>(), inner.end<float>());
+  auto mid = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+  std::nth_element(values.begin(), mid, values.end());
+  // The median of |N(0, 1)| is 0.6745.
+  return *mid / (0.6745 * 6.0);
 }
 
 }  // namespace monomap

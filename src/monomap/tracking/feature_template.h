@@ -33,8 +33,15 @@ struct AffineRefinementOptions {
   // Stop when the feature point moves less than this (px) in an iteration.
   double epsilon_px = 0.01;
   // A refinement counts only if the normalized cross-correlation of the
-  // aligned patch with the reference reaches this.
+  // aligned patch with the reference reaches this (less the share that
+  // image noise alone costs, see noise_sigma).
   double min_ncc = 0.85;
+  // Standard deviation (grey levels) of the images' noise. Noise alone
+  // lowers a perfectly aligned patch's NCC by noise_sigma^2 / s^2 (s: the
+  // reference's standard deviation), so the bar is lowered by that:
+  // otherwise low-contrast texture (painted walls) never aligns and its
+  // features drift frame to frame. 0: the bar is min_ncc.
+  double noise_sigma = 0.0;
   // ... and if it moves the feature at most this far (px) from where
   // frame-to-frame tracking put it.
   double max_correction_px = 1.5;
@@ -73,11 +80,20 @@ class FeatureTemplate {
 
  private:
   int window_ = 0;
+  double variance_ = 0.0;  // of the reference patch (grey levels^2)
   // Per pixel (row-major over the window): normalized value and the six
   // Jacobian entries d value / d (a11, a12, a21, a22, tx, ty).
   std::vector<float> values_;
   std::vector<float> jacobian_;  // 6 per pixel
   Eigen::Matrix<double, 6, 6> hessian_inverse_;
 };
+
+// Standard deviation (grey levels) of an 8-bit grey image's noise: the
+// median absolute response of a Laplacian-difference kernel that cancels
+// smooth intensity (Immerkaer, "Fast noise variance estimation", 1996),
+// scaled for Gaussian noise. The median, not the mean, so that edges and
+// texture (a minority of pixels) do not count as noise. Throws InputError
+// for an image that is not 8-bit grey or smaller than 3x3.
+double EstimateImageNoiseSigma(const cv::Mat& grey);
 
 }  // namespace monomap

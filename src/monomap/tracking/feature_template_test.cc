@@ -2,8 +2,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <opencv2/imgproc.hpp>
+#include <vector>
 
 #include "monomap/util/angles.h"
 #include "monomap/util/error.h"
@@ -92,12 +95,99 @@ TEST(FeatureTemplateTest, RejectsFlatPatchesAndWrongMatches) {
   EXPECT_EQ(a, Eigen::Matrix2f::Identity());
 }
 
+// `image` with Gaussian noise of `sigma` grey levels added.
+cv::Mat AddNoise(const cv::Mat& image, double sigma, uint64_t seed) {
+  cv::RNG rng(seed);
+  cv::Mat noise(image.size(), CV_32F);
+  rng.fill(noise, cv::RNG::NORMAL, 0.0, sigma);
+  cv::Mat sum;
+  image.convertTo(sum, CV_32F);
+  sum += noise;
+  cv::Mat out;
+  sum.convertTo(out, CV_8U);
+  return out;
+}
+
+TEST(FeatureTemplateTest, NoiseEstimateMatchesTheAddedNoise) {
+  const cv::Mat texture = MakeNoiseImage(400, 8);
+  // Quantisation alone: well under one grey level.
+  EXPECT_LT(EstimateImageNoiseSigma(texture), 0.6);
+  for (const double sigma : {1.0, 2.0, 5.0}) {
+    const double estimate =
+        EstimateImageNoiseSigma(AddNoise(texture, sigma, 9));
+    std::printf("noise %.1f: estimated %.3f\n", sigma, estimate);
+    // The texture's own curvature adds a little (0.2 at 1 grey level).
+    EXPECT_NEAR(estimate, sigma, 0.1 * sigma + 0.25);
+  }
+  EXPECT_THROW(EstimateImageNoiseSigma(cv::Mat()), InputError);
+  EXPECT_THROW(EstimateImageNoiseSigma(cv::Mat(10, 10, CV_32F)), InputError);
+}
+
+// Texture of 4 grey levels' spread under noise of 2 (a painted wall seen by
+// a webcam): noise alone holds an exact alignment's NCC near 0.8, under the
+// plain 0.85 bar. Allowing for the noise lets such features align, and a
+// wrong match still fails.
+TEST(FeatureTemplateTest, NoiseAwareBarAlignsLowContrastTexture) {
+  const cv::Mat smooth = MakeNoiseImage(300, 10);
+  cv::Mat faint;
+  smooth.convertTo(faint, CV_8U, 0.1, 128.0 - 12.8);  // spread 40 -> 4
+  const cv::Mat reference = AddNoise(faint, 2.0, 11);
+  const Eigen::Vector2d shift(0.4, -0.3);
+  const cv::Mat current = AddNoise(
+      Warp(faint, Eigen::Matrix2d::Identity(), {150, 150}, shift, 1.0, 0.0),
+      2.0, 12);
+  cv::Mat other_faint;
+  MakeNoiseImage(300, 13).convertTo(other_faint, CV_8U, 0.1, 128.0 - 12.8);
+  const cv::Mat unrelated = AddNoise(other_faint, 2.0, 14);
+  AffineRefinementOptions plain, noise_aware;
+  noise_aware.noise_sigma = 2.0;
+  int tried = 0, plain_ok = 0, aware_ok = 0, wrong_ok = 0;
+  std::vector<double> errors;
+  for (int y = 40; y <= 260; y += 20) {
+    for (int x = 40; x <= 260; x += 20) {
+      FeatureTemplate feature;
+      const Eigen::Vector2f at(x, y);
+      if (!feature.Extract(reference, at, plain)) continue;
+      ++tried;
+      for (const AffineRefinementOptions* options : {&plain, &noise_aware}) {
+        Eigen::Matrix2f a = Eigen::Matrix2f::Identity();
+        Eigen::Vector2f t = at;
+        if (!feature.Refine(current, &a, &t, *options).accepted) continue;
+        if (options == &plain) {
+          ++plain_ok;
+        } else {
+          ++aware_ok;
+          errors.push_back(((t - at).cast<double>() - shift).norm());
+        }
+      }
+      Eigen::Matrix2f a = Eigen::Matrix2f::Identity();
+      Eigen::Vector2f t = at;
+      wrong_ok += feature.Refine(unrelated, &a, &t, noise_aware).accepted;
+    }
+  }
+  std::sort(errors.begin(), errors.end());
+  const double median = errors.empty() ? 1e9 : errors[errors.size() / 2];
+  std::printf(
+      "faint texture: %d patches, aligned %d plain, %d noise-aware "
+      "(median error %.3f px), %d wrong matches accepted\n",
+      tried, plain_ok, aware_ok, median, wrong_ok);
+  ASSERT_GE(tried, 100);
+  EXPECT_LE(plain_ok, 0.3 * tried);
+  EXPECT_GE(aware_ok, 0.9 * tried);
+  // Noise of half the texture's spread limits the position to ~0.2 px.
+  EXPECT_LT(median, 0.3);
+  EXPECT_LE(wrong_ok, 0.05 * tried);  // 2 of 144 when written
+}
+
 TEST(FeatureTemplateTest, OptionsAreChecked) {
   AffineRefinementOptions options;
   options.window = 14;
   EXPECT_THROW(options.Check(), OptionsError);
   options = AffineRefinementOptions();
   options.min_ncc = 1.5;
+  EXPECT_THROW(options.Check(), OptionsError);
+  options = AffineRefinementOptions();
+  options.noise_sigma = -1.0;
   EXPECT_THROW(options.Check(), OptionsError);
 }
 

@@ -45,6 +45,7 @@ void KltTrackerOptions::Check() const {
   affine.Check();
   CheckOption(affine_interval >= 1, "affine_interval", "must be >= 1");
   CheckOption(max_affine_scale > 1.0, "max_affine_scale", "must be > 1");
+  CheckOption(alignment_retries >= 0, "alignment_retries", "must be >= 0");
 }
 
 namespace {
@@ -94,6 +95,9 @@ void KltTracker::Track(int frame_index, const cv::Mat& grey,
                        std::vector<cv::Mat> pyramid) {
   CheckFrame(frame_index, grey, pyramid);
   size_ = grey.size();
+  if (last_frame_ < 0 && options_.estimate_noise) {
+    options_.affine.noise_sigma = EstimateImageNoiseSigma(grey);
+  }
 
   KltFrameStats stats;
   stats.frame = frame_index;
@@ -123,6 +127,7 @@ void KltTracker::Track(int frame_index, const cv::Mat& grey,
   total_stats_.detected += stats.detected;
   total_stats_.refined += stats.refined;
   total_stats_.reanchored += stats.reanchored;
+  total_stats_.split += stats.split;
   total_stats_.total += stats.total;
 }
 
@@ -219,7 +224,7 @@ void KltTracker::KeepTracked(const std::vector<size_t>& forward_ok,
 void KltTracker::RefineActive(int frame_index, const cv::Mat& grey,
                               KltFrameStats* stats) {
   const int interval = options_.affine_interval;
-  std::vector<char> refined(active_.size(), 0), reanchored(active_.size(), 0);
+  std::vector<Refinement> done(active_.size());
   std::vector<cv::Point2f> correction(active_.size());
   tbb::parallel_for(tbb::blocked_range<size_t>(0, active_.size(), 32),
                     [&](const tbb::blocked_range<size_t>& r) {
@@ -227,18 +232,19 @@ void KltTracker::RefineActive(int frame_index, const cv::Mat& grey,
                         Active& f = active_[i];
                         if ((frame_index + f.id) % interval != 0) continue;
                         const cv::Point2f before = f.px;
-                        bool ref = false, re = false;
-                        RefineFeature(grey, &f, &ref, &re);
-                        refined[i] = ref;
-                        reanchored[i] = re;
+                        done[i] = RefineFeature(grey, &f);
                         correction[i] = f.px - before;
                       }
                     });
   for (size_t i = 0; i < active_.size(); ++i) {
-    stats->refined += refined[i];
-    stats->reanchored += reanchored[i];
+    stats->refined += done[i].refined;
+    stats->reanchored += done[i].reanchored;
     Active& f = active_[i];
-    if (refined[i]) {
+    if (done[i].failed && options_.split_on_failed_alignment) {
+      RenewId(&f);
+      ++stats->split;
+    }
+    if (done[i].refined) {
       // The frames since the last alignment drifted by a growing share
       // of this correction.
       const double span = frame_index - f.reference_frame;
@@ -249,8 +255,17 @@ void KltTracker::RefineActive(int frame_index, const cv::Mat& grey,
         o->px += share * Eigen::Vector2d(correction[i].x, correction[i].y);
       }
     }
-    if (refined[i] || reanchored[i]) f.reference_frame = frame_index;
+    if (done[i].refined || done[i].reanchored) {
+      f.reference_frame = frame_index;
+    }
   }
+}
+
+void KltTracker::RenewId(Active* f) {
+  f->id = next_id_++;
+  monomap::Track track;
+  track.id = f->id;
+  tracks_.push_back(std::move(track));  // this frame's observation follows
 }
 
 int KltTracker::CellOf(const cv::Point2f& p) const {
@@ -351,16 +366,22 @@ void KltTracker::Detect(int frame_index, const cv::Mat& grey,
   }
 }
 
-void KltTracker::RefineFeature(const cv::Mat& grey, Active* f, bool* refined,
-                               bool* reanchored) const {
+KltTracker::Refinement KltTracker::RefineFeature(const cv::Mat& grey,
+                                                 Active* f) const {
+  Refinement done;
   Eigen::Vector2f t(f->px.x, f->px.y);
   Eigen::Matrix2f warp = f->warp;
   bool keep_reference = false;
   if (!f->reference.empty()) {
     const AffineRefinement r =
         f->reference.Refine(grey, &warp, &t, options_.affine);
+    if (!r.accepted && ++f->failures <= options_.alignment_retries) {
+      return done;  // keep the reference: the next frame may match again
+    }
+    f->failures = 0;
+    done.failed = !r.accepted;
     if (r.accepted) {
-      *refined = true;
+      done.refined = true;
       f->px = cv::Point2f(t.x(), t.y());
       f->warp = warp;
       const Eigen::JacobiSVD<Eigen::Matrix2f> svd(warp);
@@ -369,14 +390,15 @@ void KltTracker::RefineFeature(const cv::Mat& grey, Active* f, bool* refined,
                        svd.singularValues()(1) >= 1.0f / limit;
     }
   }
-  if (keep_reference) return;
+  if (keep_reference) return done;
   // A new reference where the feature is now (frame-to-frame position if
   // the alignment failed).
   // Counted only if a patch was taken: an edge-like or flat one is refused
   // (and tried again next frame), which leaves the feature plain LK.
   f->warp.setIdentity();
-  *reanchored = f->reference.Extract(grey, Eigen::Vector2f(f->px.x, f->px.y),
-                                     options_.affine);
+  done.reanchored = f->reference.Extract(
+      grey, Eigen::Vector2f(f->px.x, f->px.y), options_.affine);
+  return done;
 }
 
 std::vector<KltFeature> KltTracker::Features() const {
@@ -476,6 +498,8 @@ TrackingReport TrackFeatures(const std::function<cv::Mat(int)>& load_grey,
   report.lost_border = totals.lost_border;
   report.refined = totals.refined;
   report.reanchored = totals.reanchored;
+  report.split = totals.split;
+  report.noise_sigma = tracker.NoiseSigma();
   report.mean_features_per_frame =
       static_cast<double>(totals.total) / num_frames;
 

@@ -11,8 +11,11 @@
 // over the image. After the frame-to-frame step every feature is aligned
 // with its reference patch by an affine-photometric Lucas-Kanade
 // (feature_template.h), which keeps frame-to-frame errors from adding up
-// into drift. Output pixels are raw (distorted); the geometric stages
-// undistort them.
+// into drift. A feature that stops aligning with its reference (twice in a
+// row) goes on under a new id: one track stays one scene point, which the
+// frame-to-frame check alone does not ensure for a point on an occlusion
+// boundary or an edge that slides slowly. Output pixels are raw (distorted);
+// the geometric stages undistort them.
 #pragma once
 
 #include <Eigen/Core>
@@ -83,6 +86,21 @@ struct KltTrackerOptions {
   // less than its inverse), or when an alignment fails: a reference seen
   // too differently no longer aligns well.
   double max_affine_scale = 1.3;
+  // Estimate the images' noise from the first frame
+  // (EstimateImageNoiseSigma) and use it as affine.noise_sigma; false:
+  // affine.noise_sigma as given.
+  bool estimate_noise = true;
+  // A failed alignment keeps the reference for this many more frames (a
+  // blurred frame, a passing highlight); the frames in between get the
+  // next successful alignment's correction spread over them. Only then is
+  // the reference given up.
+  int alignment_retries = 1;
+  // A feature whose reference is given up after failed alignments (the
+  // aligned patch no longer matches: a point on an occlusion boundary or
+  // an edge sliding) goes on under a new id from where frame-to-frame
+  // tracking put it, since it may no longer be the point it was; false: it
+  // keeps its id and only its reference is taken again.
+  bool split_on_failed_alignment = true;
 
   void Check() const;
 };
@@ -98,6 +116,7 @@ struct KltFrameStats {
   int detected = 0;               // new features started in this frame
   int refined = 0;                // positions corrected by the affine alignment
   int reanchored = 0;             // reference patches taken again
+  int split = 0;  // features given a new id after a failed alignment
   int total = 0;                  // features alive after this frame
 };
 
@@ -151,6 +170,8 @@ class KltTracker {
   const KltFrameStats& TotalStats() const { return total_stats_; }
   // Number of ids handed out so far (ids are 0, 1, 2, ...).
   int64_t NumTracksCreated() const { return next_id_; }
+  // The images' noise (grey levels) the alignment allows for.
+  double NoiseSigma() const { return options_.affine.noise_sigma; }
 
  private:
   struct Active {
@@ -160,11 +181,18 @@ class KltTracker {
     FeatureTemplate reference;
     Eigen::Matrix2f warp = Eigen::Matrix2f::Identity();
     int reference_frame = 0;  // frame of the last alignment or reference
+    int failures = 0;         // failed alignments in a row
   };
-  // Affine alignment of `f` into `grey` (see KltTrackerOptions); sets
-  // *refined / *reanchored.
-  void RefineFeature(const cv::Mat& grey, Active* f, bool* refined,
-                     bool* reanchored) const;
+  // What RefineFeature did.
+  struct Refinement {
+    bool refined = false;     // aligned with its reference
+    bool reanchored = false;  // a new reference taken
+    bool failed = false;      // it had a reference and did not align
+  };
+  // Affine alignment of `f` into `grey` (see KltTrackerOptions).
+  Refinement RefineFeature(const cv::Mat& grey, Active* f) const;
+  // Gives `f` a new id and an empty track (split_on_failed_alignment).
+  void RenewId(Active* f);
   // Throws InputError naming the frame if it cannot follow the last one.
   void CheckFrame(int frame_index, const cv::Mat& grey,
                   const std::vector<cv::Mat>& pyramid) const;
@@ -190,7 +218,7 @@ class KltTracker {
   void StartFeature(int frame_index, const cv::Mat& grey,
                     const cv::Point2f& corner);
 
-  KltTrackerOptions options_;
+  KltTrackerOptions options_;  // affine.noise_sigma set by the first frame
   int last_frame_ = -1;
   cv::Size size_;
   std::vector<cv::Mat> prev_pyramid_;
@@ -218,6 +246,10 @@ struct TrackingReport {
   // Affine alignments accepted, and reference patches taken again.
   int64_t refined = 0;
   int64_t reanchored = 0;
+  // Features that went on under a new id after a failed alignment.
+  int64_t split = 0;
+  // The images' noise (grey levels) the alignment allowed for.
+  double noise_sigma = 0.0;
   double seconds = 0.0;
   double frames_per_second = 0.0;
 };
