@@ -129,8 +129,8 @@ struct PlaneFittingOptions {
   // The same offsets in units of the points' own inlier thresholds
   // (LandmarkInlierThreshold; the centroids' in their segment's median
   // threshold) must also stay within this: pieces of a far wall differ by
-  // more than a near desk and the keyboard on it.
-  double merge_max_offset_thresholds = 1.0;
+  // more than a near desk and the keyboard on it (about 4 thresholds).
+  double merge_max_offset_thresholds = 1.5;
   // Largest gap between their polygons in the plane (m): supports that touch.
   double merge_max_gap_m = 0.3;
 

@@ -683,11 +683,21 @@ TEST(MergeCoplanar, PiecesOfAFarWallMergeWithinTheirOwnNoise) {
   EXPECT_GT(report.merges[0].offset_m, 0.012);
   EXPECT_LT(report.merges[0].offset_thresholds, 1.0);
   EXPECT_EQ(segments[0].inlier_ids.size(), 800u);
-  // Bounded in thresholds as well: the same wall seen from 1 m (10 mm
-  // thresholds) stays two planes.
-  for (auto& lm : lms) lm.mean_depth_m = 1.0;
-  const auto near = FitPlanes(PlaneFittingOptions(), &lms, &segments);
+  // Bounded in thresholds as well: seen from 1.5 m (15 mm thresholds) the
+  // pieces are still one plane, merged at 1.02 thresholds; the same two
+  // pieces measured from 0.5 m (5 mm thresholds, 1.5 mm noise: about 3.6
+  // thresholds apart) stay two.
+  for (auto& lm : lms) lm.mean_depth_m = 1.5;
+  const auto mid = FitPlanes(PlaneFittingOptions(), &lms, &segments);
+  ASSERT_EQ(mid.merges.size(), 1u);
+  EXPECT_GT(mid.merges[0].offset_thresholds, 1.0);
+  EXPECT_EQ(segments.size(), 1u);
+  std::vector<Landmark> near_lms;
+  AddPatch(0.0, 1.0, 0.0, 1.0, 0.0, 400, 0.0015, 0.5, &rng, &near_lms);
+  AddPatch(1.2, 2.2, 0.0, 1.0, 0.018, 400, 0.0015, 0.5, &rng, &near_lms);
+  const auto near = FitPlanes(PlaneFittingOptions(), &near_lms, &segments);
   EXPECT_TRUE(near.merges.empty());
+  EXPECT_EQ(segments.size(), 2u);
 }
 
 }  // namespace monomap
