@@ -83,8 +83,8 @@ struct KltTrackerOptions {
   int affine_interval = 1;
   // The reference patch is taken again from the current frame when the
   // warp has scaled it by more than this factor in some direction (or
-  // less than its inverse), or when an alignment fails: a reference seen
-  // too differently no longer aligns well.
+  // less than its inverse), or when alignments fail (alignment_retries): a
+  // reference seen too differently no longer aligns well.
   double max_affine_scale = 1.3;
   // Estimate the images' noise from the first frame
   // (EstimateImageNoiseSigma) and use it as affine.noise_sigma; false:
@@ -187,7 +187,7 @@ class KltTracker {
   struct Refinement {
     bool refined = false;     // aligned with its reference
     bool reanchored = false;  // a new reference taken
-    bool failed = false;      // it had a reference and did not align
+    bool failed = false;      // its reference given up after failures
   };
   // Affine alignment of `f` into `grey` (see KltTrackerOptions).
   Refinement RefineFeature(const cv::Mat& grey, Active* f) const;
